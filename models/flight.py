@@ -1,0 +1,214 @@
+"""Open- and closed-loop flight of a trimmed aircraft, sampled on exact sample times."""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import jsbsim
+import numpy as np
+
+from models.aircraft import Aircraft
+from models.trim import G0_FPS2, TrimPoint
+
+Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
+
+
+class FlightError(RuntimeError):
+    """The simulation diverged or produced invalid numbers; the message says when and what."""
+
+
+@dataclass(frozen=True)
+class Loop:
+    """How the stabilator is driven.
+
+    ``kind='open'``: surfaces are the trim values plus the input (FCS disabled).
+    ``kind='closed'``: the project's own pitch-rate feedback, δs = δs,trim + δs,cmd + K·q
+    (seed §III.G), with K = ``pitch_rate_gain`` in rad of stabilator per rad/s of pitch rate.
+    Positive K damps the short period (the F-16's Cm_δe is negative and δe is positive
+    trailing edge down). The feedback uses the pitch rate of the previous frame, as a digital
+    flight control computer would.
+    """
+
+    kind: str = "open"
+    pitch_rate_gain: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("open", "closed"):
+            raise ValueError(f"loop kind must be 'open' or 'closed', not {self.kind!r}")
+        if self.kind == "open" and self.pitch_rate_gain != 0.0:
+            raise ValueError("an open loop has no feedback gain; use Loop('closed', K)")
+        if not math.isfinite(self.pitch_rate_gain):
+            raise ValueError("the pitch-rate gain must be finite")
+
+    def describe(self) -> str:
+        return "open loop" if self.kind == "open" else f"closed loop, de = de_cmd + {self.pitch_rate_gain:g}*q"
+
+
+# Recorded channel -> (JSBSim property, scale). Rates are body rates relative to the Earth,
+# which in still air are the rates the aerodynamics see (they differ from inertial rates by
+# Earth's rotation, at most 7.3e-5 rad/s). Accelerometer channels are computed separately.
+_STATE_CHANNELS: tuple[tuple[str, str], ...] = (
+    ("V_fps", "velocities/vt-fps"),
+    ("alpha_rad", "aero/alpha-rad"),
+    ("beta_rad", "aero/beta-rad"),
+    ("p_rps", "velocities/p-rad_sec"),
+    ("q_rps", "velocities/q-rad_sec"),
+    ("r_rps", "velocities/r-rad_sec"),
+    ("phi_rad", "attitude/phi-rad"),
+    ("theta_rad", "attitude/theta-rad"),
+    ("psi_rad", "attitude/psi-rad"),
+    ("qbar_psf", "aero/qbar-psf"),
+    ("h_ft", "position/h-sl-ft"),
+    ("mach_1", "velocities/mach"),
+    ("thrust_lbf", "forces/fbx-prop-lbs"),
+    ("pdot_rps2", "accelerations/pdot-rad_sec2"),
+    ("qdot_rps2", "accelerations/qdot-rad_sec2"),
+    ("rdot_rps2", "accelerations/rdot-rad_sec2"),
+    ("throttle_1", "fcs/throttle-pos-norm"),
+)
+_FORCES = ("forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs")
+_AERO = ("forces/fbx-aero-lbs", "forces/fby-aero-lbs", "forces/fbz-aero-lbs",
+         "moments/l-aero-lbsft", "moments/m-aero-lbsft", "moments/n-aero-lbsft")
+
+
+@dataclass(frozen=True)
+class FlightHistory:
+    """Sampled time histories of one flight.
+
+    ``channels`` uses the recording format's canonical column names; ``truth`` holds
+    JSBSim's own aerodynamic coefficients about the c.g. (non-dimensional, aero only) per
+    sample: CX, CY, CZ, Cl, Cm, Cn and the wind-axis CL, CD of the seed's Eq. 2, plus the
+    angle-of-attack rate JSBSim used.
+    """
+
+    channels: dict[str, np.ndarray]
+    truth: dict[str, np.ndarray]
+    sample_rate_hz: float
+    sim_rate_hz: float
+    frames: int
+    loop: Loop = field(default_factory=Loop)
+
+
+def frames_per_sample(sample_rate_hz: float, sim_rate_hz: float) -> int:
+    """Whole simulation frames per recorded sample: the smallest count that runs at least
+    ``sim_rate_hz``. 120 Hz asked with 50 Hz recording gives 3 (the simulation runs at
+    150 Hz), so every sample is a simulation frame rather than an interpolation."""
+    if sample_rate_hz <= 0 or sim_rate_hz <= 0:
+        raise ValueError("sample and simulation rates must be positive")
+    return max(1, math.ceil(sim_rate_hz / sample_rate_hz - 1e-9))
+
+
+def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
+        deflections: Deflections, duration_s: float, *, sample_rate_hz: float = 50.0,
+        sim_rate_hz: float = 120.0, loop: Loop = Loop(),
+        alpha_limit_rad: float = math.radians(40.0)) -> FlightHistory:
+    """Fly a trimmed instance with the surfaces driven directly and record it.
+
+    Parameters
+    ----------
+    fdm : jsbsim.FGFDMExec
+        Trimmed by :func:`models.trim.trim`. Its FCS is disabled here, so the surfaces hold
+        what is written each frame (and the F-16's leading-edge flap stays at its trim value).
+    deflections : callable
+        ``t -> {'de': rad, 'da': rad, 'dr': rad}``, perturbations from trim evaluated on the
+        frame times (zero-order hold between frames).
+    duration_s : float
+        Length of the recording; samples at ``k / sample_rate_hz`` for ``k = 0 .. N-1`` with
+        ``N = round(duration_s * sample_rate_hz) + 1``.
+
+    Raises
+    ------
+    FlightError
+        When the states become non-finite or leave the flight envelope (|alpha| or |beta|
+        beyond ``alpha_limit_rad``, airspeed below half its trim value): the message names
+        the time, the channel and the value.
+    """
+    n_sub = frames_per_sample(sample_rate_hz, sim_rate_hz)
+    dt = 1.0 / (n_sub * sample_rate_hz)
+    n_samples = int(round(duration_s * sample_rate_hz)) + 1
+    n_frames = (n_samples - 1) * n_sub
+    fdm.set_dt(dt)
+    fdm["simulation/models/FGFCS/enabled"] = 0
+
+    t_frames = np.arange(n_frames + 1) * dt
+    commands = {s: np.asarray(v, dtype=float) for s, v in deflections(t_frames).items()}
+    trim_pos = {"de": trim_point.de_rad, "da": trim_point.da_rad, "dr": trim_point.dr_rad}
+    unknown = set(commands) - set(trim_pos)
+    if unknown:
+        raise ValueError(f"unknown surfaces {sorted(unknown)}; the aircraft has de, da, dr")
+    props = aircraft.surfaces
+    # Plain lists index far faster than numpy scalars in the frame loop.
+    driven = [(props[s], (trim_pos[s] + commands[s]).tolist()) for s in commands]
+    de_prop = props["de"]
+    gain = loop.pitch_rate_gain if loop.kind == "closed" else 0.0
+    de_cmd = (trim_pos["de"] + commands.get("de", np.zeros(n_frames + 1))).tolist()
+    if gain:
+        driven = [(p, v) for p, v in driven if p != de_prop]
+    for prop, values in driven:
+        fdm[prop] = values[0]
+    last = {prop: values[0] for prop, values in driven}
+
+    read_props = ([p for _, p in _STATE_CHANNELS] + [props["de"], props["da"], props["dr"]]
+                  + list(_FORCES) + list(_AERO) + ["aero/alphadot-rad_sec"])
+    i_alpha = 1
+    i_beta = 2
+    rows: list[tuple[float, ...]] = []
+
+    def sample() -> None:
+        row = tuple([fdm[p] for p in read_props])
+        rows.append(row)
+        a, b, v = row[i_alpha], row[i_beta], row[0]
+        # NaN fails every comparison, so "not (x < limit)" also catches it.
+        if not (abs(a) < alpha_limit_rad and abs(b) < alpha_limit_rad and v > 0.5 * trim_point.V_fps):
+            t = (len(rows) - 1) / sample_rate_hz
+            raise FlightError(
+                f"simulation diverged at t = {t:.2f} s ({loop.describe()}): alpha = {math.degrees(a):.1f} deg, "
+                f"beta = {math.degrees(b):.1f} deg, V = {v:.0f} ft/s (limits: |alpha|, |beta| < "
+                f"{math.degrees(alpha_limit_rad):.0f} deg, V > {0.5 * trim_point.V_fps:.0f} ft/s); "
+                "the aircraft is unstable for this loop or the input is too large")
+
+    sample()
+    run = fdm.run
+    for f in range(1, n_frames + 1):
+        for prop, values in driven:
+            v = values[f]
+            if v != last[prop]:
+                fdm[prop] = v
+                last[prop] = v
+        if gain:
+            fdm[de_prop] = de_cmd[f] + gain * fdm["velocities/q-rad_sec"]
+        run()
+        if f % n_sub == 0:
+            sample()
+
+    out = np.asarray(rows, dtype=float)
+    bad = ~np.isfinite(out)
+    if bad.any():
+        k, col = np.argwhere(bad)[0]
+        raise FlightError(f"simulation produced a non-finite {read_props[col]} at t = {k / sample_rate_hz:.2f} s")
+    state_cols = [c for c, _ in _STATE_CHANNELS]
+    surf_cols = ["de_rad", "da_rad", "dr_rad"]
+    mass = fdm["inertia/mass-slugs"]
+    channels = {"t_s": np.arange(n_samples) / sample_rate_hz}
+    for i, col in enumerate(state_cols):
+        channels[col] = out[:, i]
+    j = len(state_cols)
+    for i, col in enumerate(surf_cols):
+        channels[col] = out[:, j + i]
+    for i, col in enumerate(("ax_g", "ay_g", "az_g")):
+        channels[col] = out[:, j + 3 + i] / (mass * G0_FPS2)
+    qS = channels["qbar_psf"] * trim_point.S_ft2
+    X, Y, Z, L, M, N = (out[:, j + 6 + i] for i in range(6))
+    alpha = channels["alpha_rad"]
+    CX, CZ = X / qS, Z / qS
+    truth = {
+        "CX": CX, "CY": Y / qS, "CZ": CZ,
+        "Cl": L / (qS * trim_point.b_ft), "Cm": M / (qS * trim_point.cbar_ft), "Cn": N / (qS * trim_point.b_ft),
+        # Seed Eq. 2
+        "CD": -CX * np.cos(alpha) - CZ * np.sin(alpha),
+        "CL": -CZ * np.cos(alpha) + CX * np.sin(alpha),
+        "alphadot": out[:, j + 12],
+    }
+    return FlightHistory(channels=channels, truth=truth, sample_rate_hz=sample_rate_hz,
+                         sim_rate_hz=n_sub * sample_rate_hz, frames=n_frames, loop=loop)
