@@ -93,8 +93,11 @@ def load_fdm(aircraft: Aircraft, dt: float, *, root: Path | None = None,
     return new_fdm(root, name or aircraft.model, dt)
 
 
-def place_reference_point(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> None:
-    """Apply the variant's aerodynamic reference point (needs the mass model: after run_ic)."""
+def place_reference_point(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> bool:
+    """Apply the variant's aerodynamic reference point (needs the mass model: after run_ic).
+
+    Returns whether it moved (the caller then re-initialises)."""
+    moved = aircraft.model == "737" or aircraft.variant in ("exact-truth", "unstable")
     if aircraft.model == "737" or aircraft.variant == "exact-truth":
         # Moments about the c.g.: put the aerodynamic reference point on it.
         for ax in "xyz":
@@ -102,3 +105,4 @@ def place_reference_point(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> None:
     if aircraft.variant == "unstable":
         # JSBSim's structural x axis points aft: forward is more negative.
         fdm["metrics/aero-rp-x-in"] = fdm["metrics/aero-rp-x-in"] - aircraft.rp_shift_in
+    return moved

@@ -138,16 +138,18 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     if unknown:
         raise ValueError(f"unknown surfaces {sorted(unknown)}; the aircraft has de, da, dr")
     props = aircraft.surfaces
-    # Plain lists index far faster than numpy scalars in the frame loop.
-    driven = [(props[s], (trim_pos[s] + commands[s]).tolist()) for s in commands]
-    de_prop = props["de"]
     gain = loop.pitch_rate_gain if loop.kind == "closed" else 0.0
+    de_prop = props["de"]
     de_cmd = (trim_pos["de"] + commands.get("de", np.zeros(n_frames + 1))).tolist()
-    if gain:
-        driven = [(p, v) for p, v in driven if p != de_prop]
-    for prop, values in driven:
-        fdm[prop] = values[0]
-    last = {prop: values[0] for prop, values in driven}
+    # Surface writes only where a value changes: {frame: [(property, value), ...]}.
+    changes: dict[int, list[tuple[str, float]]] = {}
+    for s, cmd in commands.items():
+        if gain and s == "de":
+            continue  # written every frame with the feedback below
+        values = trim_pos[s] + cmd
+        fdm[props[s]] = float(values[0])
+        for f in (np.flatnonzero(np.diff(values)) + 1).tolist():
+            changes.setdefault(f, []).append((props[s], float(values[f])))
 
     read_props = ([p for _, p in _STATE_CHANNELS] + [props["de"], props["da"], props["dr"]]
                   + list(_FORCES) + list(_AERO) + ["aero/alphadot-rad_sec"])
@@ -170,17 +172,17 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
 
     sample()
     run = fdm.run
-    for f in range(1, n_frames + 1):
-        for prop, values in driven:
-            v = values[f]
-            if v != last[prop]:
-                fdm[prop] = v
-                last[prop] = v
-        if gain:
-            fdm[de_prop] = de_cmd[f] + gain * fdm["velocities/q-rad_sec"]
-        run()
-        if f % n_sub == 0:
-            sample()
+    f = 0
+    for _ in range(n_samples - 1):
+        for _ in range(n_sub):
+            f += 1
+            if f in changes:
+                for prop, v in changes[f]:
+                    fdm[prop] = v
+            if gain:
+                fdm[de_prop] = de_cmd[f] + gain * fdm["velocities/q-rad_sec"]
+            run()
+        sample()
 
     out = np.asarray(rows, dtype=float)
     bad = ~np.isfinite(out)

@@ -106,8 +106,8 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     set_initial_condition(fdm, condition.h_ft, condition.V_fps)
     fdm["propulsion/set-running"] = -1
     fdm.run_ic()
-    place_reference_point(fdm, aircraft)
-    fdm.run_ic()
+    if place_reference_point(fdm, aircraft):
+        fdm.run_ic()
     try:
         fdm.do_trim(1)
     except jsbsim.TrimFailureError as exc:

@@ -73,6 +73,18 @@ class Derivatives:
             return self.unsteady[name]
         raise KeyError(f"no truth derivative {name!r}; known: {sorted(table) + sorted(self.unsteady)}")
 
+    @classmethod
+    def from_dict(cls, d: Mapping) -> "Derivatives":
+        """Inverse of :meth:`as_dict` (e.g. from a recording's ``meta['truth']``)."""
+        derivs = d["derivatives"]
+        steady = {k: v for k, v in derivs.items() if not k.endswith("_alphadot")}
+        return cls(aircraft=d["aircraft"], condition=dict(d["condition"]),
+                   local={k: v["local"] for k, v in steady.items()},
+                   fit={k: v["fit"] for k, v in steady.items()},
+                   trim_coefficients=dict(d["trim_coefficients"]),
+                   excursion={k: tuple(v) for k, v in d.get("excursion", {}).items()},
+                   unsteady={k: v["local"] for k, v in derivs.items() if k.endswith("_alphadot")})
+
     def as_dict(self) -> dict:
         """The JSON form written by ``sidbench truth``."""
         derivs = {n: {"local": self.local[n], "fit": self.fit[n]} for n in self.local}

@@ -1,0 +1,108 @@
+"""Force and moment coefficients from measured quantities (seed Eqs. 1-5).
+
+These are the "measured" coefficients of equation error: computed from accelerometers,
+rates, angular accelerations, air data, thrust, mass, inertia and geometry.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pandas as pd
+
+from maneuvers.recording import G0_FPS2, Recording
+
+
+def accelerometer_at_cg(ax_g, ay_g, az_g, p, q, r, pdot, qdot, rdot, r_ft) -> tuple[np.ndarray, ...]:
+    """Move accelerometer readings (g) from the sensor position ``r_ft`` (body axes, from
+    the c.g.) to the c.g.: a_cg = a_s − [ω̇ × r + ω × (ω × r)] / g₀."""
+    x, y, z = (float(v) for v in r_ft)
+    if x == y == z == 0.0:
+        return np.asarray(ax_g), np.asarray(ay_g), np.asarray(az_g)
+    w = np.stack([p, q, r], axis=-1)
+    wd = np.stack([pdot, qdot, rdot], axis=-1)
+    rv = np.array([x, y, z])
+    extra = np.cross(wd, rv) + np.cross(w, np.cross(w, rv))
+    return ax_g - extra[:, 0] / G0_FPS2, ay_g - extra[:, 1] / G0_FPS2, az_g - extra[:, 2] / G0_FPS2
+
+
+def force_coefficients(ax_g, ay_g, az_g, thrust_lbf, qbar_psf, mass_slug, S_ft2) -> dict[str, np.ndarray]:
+    """Seed Eq. 1: CX = (m a_x − T)/(q̄S), CY = m a_y/(q̄S), CZ = m a_z/(q̄S).
+
+    Accelerations are specific forces at the c.g. in g (a_z ≈ −1 in level flight); thrust
+    acts along body x."""
+    qS = np.asarray(qbar_psf) * S_ft2
+    m = np.asarray(mass_slug) * G0_FPS2
+    return {"CX": (m * ax_g - thrust_lbf) / qS, "CY": m * ay_g / qS, "CZ": m * az_g / qS}
+
+
+def wind_axis_coefficients(CX, CZ, alpha) -> dict[str, np.ndarray]:
+    """Seed Eq. 2: CD = −CX cos α − CZ sin α, CL = −CZ cos α + CX sin α."""
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    return {"CD": -CX * ca - CZ * sa, "CL": -CZ * ca + CX * sa}
+
+
+def moment_coefficients(p, q, r, pdot, qdot, rdot, qbar_psf, S_ft2, b_ft, cbar_ft,
+                        Ix, Iy, Iz, Ixz, thrust_lbf=0.0, thrust_offset_ft=0.0) -> dict[str, np.ndarray]:
+    """Seed Eqs. 3-5, with the thrust line's pitching moment removed from Cm.
+
+    Cl = Ix/(q̄Sb) [ṗ − Ixz/Ix (pq + ṙ) + (Iz − Iy)/Ix qr]
+    Cm = Iy/(q̄Sc̄) [q̇ + (Ix − Iz)/Iy pr + Ixz/Iy (p² − r²)] − T z_T/(q̄Sc̄)
+    Cn = Iz/(q̄Sb) [ṙ − Ixz/Iz (ṗ − qr) + (Iy − Ix)/Iz pq]
+
+    ``Ixz`` has the seed's sign (positive 982 slug·ft² in its F-16 Table 1); ``thrust_offset_ft``
+    is the thrust line's body-z position (positive below the c.g.), so the thrust moment is
+    +T·z_T.
+    """
+    qS = np.asarray(qbar_psf) * S_ft2
+    Cl = Ix / (qS * b_ft) * (pdot - Ixz / Ix * (p * q + rdot) + (Iz - Iy) / Ix * q * r)
+    Cm = (Iy / (qS * cbar_ft) * (qdot + (Ix - Iz) / Iy * p * r + Ixz / Iy * (p**2 - r**2))
+          - np.asarray(thrust_lbf) * thrust_offset_ft / (qS * cbar_ft))
+    Cn = Iz / (qS * b_ft) * (rdot - Ixz / Iz * (pdot - q * r) + (Iy - Ix) / Iz * p * q)
+    return {"Cl": Cl, "Cm": Cm, "Cn": Cn}
+
+
+Differentiator = Callable[[np.ndarray, float], np.ndarray]
+
+
+def coefficients_from_recording(rec: Recording, differentiate: Differentiator | None = None) -> pd.DataFrame:
+    """CX, CY, CZ, CL, CD, Cl, Cm, Cn from a recording's channels (Eqs. 1-5).
+
+    Parameters
+    ----------
+    rec : Recording
+        Canonical recording; thrust is taken as recorded, or as ``meta['trim']['thrust_lbf']``
+        (constant) when the channel is absent, or zero.
+    differentiate : callable or None
+        ``(x, dt) -> dx/dt`` used for the angular accelerations. ``None`` uses the recorded
+        ``pdot``, ``qdot``, ``rdot`` channels (refused, naming them, if absent).
+    """
+    p, q, r = rec.channel("p"), rec.channel("q"), rec.channel("r")
+    if differentiate is None:
+        pdot, qdot, rdot = rec.channel("pdot"), rec.channel("qdot"), rec.channel("rdot")
+    else:
+        pdot, qdot, rdot = (differentiate(x, rec.dt) for x in (p, q, r))
+    g, m = rec.geometry, rec.mass_at()
+    if rec.has("thrust"):
+        thrust = rec.channel("thrust")
+    else:
+        thrust = float(rec.meta.get("trim", {}).get("thrust_lbf", 0.0))
+    r_acc = rec.meta.get("sensors", {}).get("accelerometer_ft", [0.0, 0.0, 0.0])
+    ax, ay, az = accelerometer_at_cg(rec.channel("ax"), rec.channel("ay"), rec.channel("az"),
+                                     p, q, r, pdot, qdot, rdot, r_acc)
+    qbar = rec.channel("qbar")
+    out = force_coefficients(ax, ay, az, thrust, qbar, m["mass_slug"], g["S_ft2"])
+    out.update(wind_axis_coefficients(out["CX"], out["CZ"], rec.channel("alpha")))
+    out.update(moment_coefficients(p, q, r, pdot, qdot, rdot, qbar, g["S_ft2"], g["b_ft"], g["cbar_ft"],
+                                   m["Ix_slugft2"], m["Iy_slugft2"], m["Iz_slugft2"], m["Ixz_slugft2"],
+                                   thrust, float(rec.meta.get("thrust_offset_ft", 0.0))))
+    return pd.DataFrame(out)
+
+
+def normalized_rates(rec: Recording, V_ref: float | None = None) -> dict[str, np.ndarray]:
+    """p̂ = pb/2V, q̂ = qc̄/2V, r̂ = rb/2V with the instantaneous airspeed (or ``V_ref``, the
+    seed's V_o of Eqs. 8-11)."""
+    V = rec.channel("V") if V_ref is None else V_ref
+    g = rec.geometry
+    return {"phat": rec.channel("p") * g["b_ft"] / (2 * V), "qhat": rec.channel("q") * g["cbar_ft"] / (2 * V),
+            "rhat": rec.channel("r") * g["b_ft"] / (2 * V)}

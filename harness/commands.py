@@ -1,0 +1,77 @@
+"""Subcommands of ``sidbench`` that fly, compute truth and convert recordings."""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from harness.atomic import write_json_atomic
+
+
+def cmd_fly(args: argparse.Namespace) -> int:
+    from harness.flying import spec_from_args
+    from harness.recording_io import write_recording
+    from maneuvers.fly import fly_maneuver
+
+    spec = spec_from_args(args)
+    rec = fly_maneuver(spec)
+    path = write_recording(rec, args.out)
+    print(f"flew {spec.describe()}")
+    print(f"wrote {path} ({rec.n} samples)" + (f" and {Path(path).with_suffix('.meta.json')}"
+                                               if Path(path).suffix == ".csv" else ""))
+    return 0
+
+
+def cmd_truth(args: argparse.Namespace) -> int:
+    from maneuvers.fly import default_truth, truth_table
+    from models.aircraft import Aircraft
+
+    aircraft = Aircraft(args.aircraft, args.variant)
+    truth = default_truth(aircraft, args.condition)
+    print(truth_table(truth))
+    if args.check_linearization:
+        from models.conditions import condition_for
+        from models.exact import exact_truth_root
+        from models.linearization import CHECKED, linearization_derivatives
+        cond = condition_for(args.aircraft, args.condition)
+        kwargs = {}
+        if args.variant == "exact-truth":
+            root, name = exact_truth_root(aircraft, cond)
+            kwargs = {"root": root, "name": name}
+        lin = linearization_derivatives(aircraft, cond, **kwargs)
+        print("\nCross-check against jsbsim.FGLinearization (state derivatives only):")
+        print(f"{'derivative':<12}{'central diff':>14}{'linearization':>15}{'rel diff':>10}")
+        for k in CHECKED:
+            a, b = truth.local[k], lin[k]
+            print(f"{k:<12}{a:>14.6f}{b:>15.6f}{abs(a - b) / max(abs(a), 1e-9):>10.1e}")
+    if args.json:
+        write_json_atomic(args.json, truth.as_dict())
+        print(f"\nwrote {args.json}")
+    return 0
+
+
+def cmd_import(args: argparse.Namespace) -> int:
+    from harness.recording_io import read_recording, write_recording
+
+    rec = read_recording(args.file)
+    path = write_recording(rec, args.out)
+    print(f"imported {args.file}: {rec.n} samples at {1 / rec.dt:g} Hz, channels "
+          + ", ".join(c for c in rec.data.columns))
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    from harness.recording_io import write_recording
+    from maneuvers.fly import FlightSpec, fly_maneuver, truth_table
+    from models.truth import Derivatives
+
+    out = Path(args.out)
+    spec = FlightSpec()
+    rec = fly_maneuver(spec)
+    truth = Derivatives.from_dict(rec.meta["truth"])
+    path = write_recording(rec, out / "f16_stabilator_2112.csv")
+    print(f"Flew {spec.describe()}.\n")
+    print(truth_table(truth))
+    print(f"\nRecording: {path.resolve()} (+ {path.with_suffix('.meta.json').name}), {rec.n} samples")
+    return 0

@@ -1,0 +1,59 @@
+"""Command-line options that define a flight, and turning them into a FlightSpec."""
+from __future__ import annotations
+
+import argparse
+
+INPUT_CHOICES = ("doublet", "2-1-1-2", "2-1-1", "3-2-1-1", "sweep-linear", "sweep-log", "multisine",
+                 "three-axis", "lateral")
+
+
+def add_flight_options(p: argparse.ArgumentParser) -> None:
+    """Options shared by every command that flies an aircraft."""
+    p.add_argument("--aircraft", default="f16", choices=["f16", "737"], help="JSBSim model (default f16)")
+    p.add_argument("--variant", default="nominal", choices=["nominal", "exact-truth", "unstable"],
+                   help="nominal; exact-truth (aerodynamics exactly linear, seed §III.C); "
+                        "unstable (aero reference point moved forward)")
+    p.add_argument("--condition", default=None, help="flight condition: f16 seed-5deg (default) or alpha-7.5; 737 cruise")
+    p.add_argument("--maneuver", default="2-1-1-2", choices=INPUT_CHOICES,
+                   help="input design (default 2-1-1-2); three-axis = de 2-1-1-2, da doublet, dr 2-1-1; "
+                        "lateral = da doublet then dr 2-1-1")
+    p.add_argument("--surface", default="de", help="de, da or dr (a comma list for multisine)")
+    p.add_argument("--amplitude-deg", type=float, default=1.0, help="pulse height / sweep amplitude / multisine peak, deg")
+    p.add_argument("--unit-pulse-s", type=float, default=1.0, help="unit pulse width of multi-step inputs, s")
+    p.add_argument("--sample-rate", type=float, default=50.0, help="recording rate, Hz (default 50)")
+    p.add_argument("--sim-rate", type=float, default=120.0,
+                   help="least simulation rate, Hz (default 120; raised to a whole multiple of the sample rate)")
+    p.add_argument("--duration", type=float, default=None, help="recording length, s (default 20 or the input's length)")
+    p.add_argument("--loop", default="open", help="'open' or 'closed:K' for de = de_cmd + K*q (K in rad per rad/s)")
+
+
+def parse_loop(text: str):
+    """``'open'`` or ``'closed:K'`` -> :class:`models.flight.Loop`."""
+    from models.flight import Loop
+    if text == "open":
+        return Loop()
+    kind, _, gain = text.partition(":")
+    if kind != "closed" or not gain:
+        raise ValueError(f"--loop must be 'open' or 'closed:K' (e.g. closed:0.5), not {text!r}")
+    try:
+        return Loop("closed", float(gain))
+    except ValueError:
+        raise ValueError(f"--loop closed:K needs a number for K, not {gain!r}") from None
+
+
+def spec_from_args(args: argparse.Namespace):
+    """Build the :class:`maneuvers.fly.FlightSpec` the options describe."""
+    from maneuvers.fly import FlightSpec
+    from maneuvers.inputs import default_lateral_input, default_three_axis_input, make_input
+    from models.aircraft import Aircraft
+
+    if args.maneuver == "three-axis":
+        signal = default_three_axis_input()
+    elif args.maneuver == "lateral":
+        signal = default_lateral_input()
+    else:
+        signal = make_input(args.maneuver, args.surface, args.amplitude_deg, args.unit_pulse_s,
+                            sample_rate_hz=args.sample_rate)
+    return FlightSpec(input=signal, aircraft=Aircraft(args.aircraft, args.variant), condition=args.condition,
+                      duration_s=args.duration, sample_rate_hz=args.sample_rate, sim_rate_hz=args.sim_rate,
+                      loop=parse_loop(args.loop))
