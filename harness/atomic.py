@@ -22,6 +22,10 @@ def write_atomic(path: str | Path, writer: Callable[[IO[bytes]], Any]) -> Path:
             writer(fh)
             fh.flush()
             os.fsync(fh.fileno())
+        # mkstemp creates 0600; give the file the permissions an ordinary open() would.
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

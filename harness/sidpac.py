@@ -1,0 +1,405 @@
+"""Import SIDPAC flight-test ``.mat`` files into the canonical recording format.
+
+A SIDPAC data file holds a time vector ``t`` (starting at 0), a data matrix
+``fdata`` (N x 90) and a struct ``fds`` with the same data plus labels
+(``varlab``), units (``varunits``, e.g. ``' (deg) '``), geometry (``sarea``,
+``bspan``, ``cbar``) and descriptive fields. Column numbers below are SIDPAC's,
+1-based.
+
+Mapping
+-------
+* ``time`` (col 1): dropped as a channel; the recording's time is ``t`` (from 0)
+  and the file's absolute start time goes to ``meta['sidpac']['start_time_s']``.
+* Labelled channels of the format (``V``, ``alpha``, ``beta``, ``p``, ``q``, ``r``,
+  ``phi``, ``the`` -> ``theta``, ``psi``, ``ax``/``ay``/``az`` (c.g.-referenced),
+  ``el`` -> ``de``, ``ail`` -> ``da``, ``rdr`` -> ``dr``, ``qbar``, ``mach``,
+  ``alt`` -> ``h``, ``thrust``, ``pdot``/``qdot``/``rdot``) become canonical
+  channels (angles converted to rad, rates to rad/s).
+* ``mass``, ``Ixx``, ``Iyy``, ``Izz``, ``Ixz``: constant -> scalar in
+  ``meta['mass']``; varying -> channel (``mass_slug``, ``Ix_slugft2``, ...).
+* ``xcg``/``ycg``/``zcg`` (in) -> ``meta['sidpac']['cg_in']``.
+* ``sarea``/``bspan``/``cbar`` -> ``meta['geometry']`` (from the ``fds`` fields).
+* Every other labelled column with a known unit and not all zero -> extra channel in
+  canonical units (``axm_g``, ``alphadot_rps``, ``CY_1``, ``phat_1``, ``u_fps``,
+  ``tef_rad``, ``lonstk_ft``...). Blank-labelled and all-zero columns are dropped,
+  except required channels, which are kept even if all zero -- with one exception:
+  an all-zero ``qbar`` is physically impossible in flight and is treated as absent.
+* A missing ``qbar`` is derived, and the derivation is written to
+  ``meta['import_notes']``: from ``rho`` and ``V`` (0.5 rho V^2) when ``rho`` is
+  recorded, otherwise from ``mach`` and ``alt`` taken as pressure altitude
+  (0.7 p(h) M^2 with the ISA static pressure). If neither is possible the file is
+  refused naming ``qbar_psf``.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import scipy.io
+
+from maneuvers.recording import (
+    CHANNELS,
+    FORMAT_ID,
+    REQUIRED_QUANTITIES,
+    Recording,
+    RecordingError,
+    to_canonical,
+)
+
+__all__ = ["import_sidpac", "isa_pressure_psf"]
+
+# SIDPAC unit text (inside the parentheses) -> unit string of the recording format.
+_SIDPAC_UNITS: dict[str, str] = {
+    "sec": "s",
+    "fps": "fps",
+    "rad": "rad",
+    "deg": "deg",
+    "rps": "rps",
+    "dps": "dps",
+    "rps2": "rps2",
+    "dps2": "dps2",
+    "g": "g",
+    "psf": "psf",
+    "ft": "ft",
+    "lbf": "lbf",
+    "slug": "slug",
+    "slug-ft2": "slugft2",
+    "": "1",
+}
+_IN_FT = 1.0 / 12.0
+
+# SIDPAC label -> quantity of the format's channel table.
+_LABEL_TO_QUANTITY: dict[str, str] = {
+    "V": "V", "alpha": "alpha", "beta": "beta",
+    "p": "p", "q": "q", "r": "r",
+    "phi": "phi", "the": "theta", "psi": "psi",
+    "ax": "ax", "ay": "ay", "az": "az",
+    "el": "de", "ail": "da", "rdr": "dr",
+    "qbar": "qbar", "mach": "mach", "alt": "h", "thrust": "thrust",
+    "pdot": "pdot", "qdot": "qdot", "rdot": "rdot",
+    # Mass properties. Ixz: SIDPAC uses the same sign convention as the seed's
+    # Eqs. 3-5 (the format's convention), so the value is copied as is.
+    "mass": "mass", "Ixx": "Ix", "Iyy": "Iy", "Izz": "Iz", "Ixz": "Ixz",
+}
+_MASS_QUANTITIES = ("mass", "Ix", "Iy", "Iz", "Ixz")
+_CG_LABELS = ("xcg", "ycg", "zcg")
+_GEOMETRY_FIELDS = {"sarea": "S_ft2", "bspan": "b_ft", "cbar": "cbar_ft"}
+
+# ISA (ICAO standard atmosphere) constants, SI.
+_ISA_T0_K = 288.15
+_ISA_P0_PA = 101325.0
+_ISA_LAPSE_K_PER_M = 0.0065
+_ISA_R_J_PER_KG_K = 287.05287
+_ISA_G0 = 9.80665
+_ISA_TROPOPAUSE_M = 11000.0
+_ISA_TOP_M = 20000.0
+_GAMMA_AIR = 1.4
+_FT_M = 0.3048
+
+
+def isa_pressure_psf(h_ft: np.ndarray) -> np.ndarray:
+    """Static pressure of the ISA at pressure altitude ``h_ft`` (up to 20 km).
+
+    Parameters
+    ----------
+    h_ft : numpy.ndarray
+        Pressure altitude, ft.
+
+    Returns
+    -------
+    numpy.ndarray
+        Static pressure, lbf/ft^2.
+
+    Raises
+    ------
+    ValueError
+        If an altitude lies above 20 km (65617 ft), beyond the two layers modelled.
+    """
+    h_m = np.asarray(h_ft, dtype=np.float64) * _FT_M
+    if np.any(h_m > _ISA_TOP_M):
+        raise ValueError(f"altitude above {_ISA_TOP_M / _FT_M:.0f} ft is outside the ISA layers modelled")
+    exponent = _ISA_G0 / (_ISA_R_J_PER_KG_K * _ISA_LAPSE_K_PER_M)
+    t11 = _ISA_T0_K - _ISA_LAPSE_K_PER_M * _ISA_TROPOPAUSE_M
+    p11 = _ISA_P0_PA * (t11 / _ISA_T0_K) ** exponent
+    tropo = _ISA_P0_PA * (1.0 - _ISA_LAPSE_K_PER_M * np.minimum(h_m, _ISA_TROPOPAUSE_M) / _ISA_T0_K) ** exponent
+    strato = p11 * np.exp(-_ISA_G0 * (h_m - _ISA_TROPOPAUSE_M) / (_ISA_R_J_PER_KG_K * t11))
+    p_pa = np.where(h_m <= _ISA_TROPOPAUSE_M, tropo, strato)
+    return p_pa * CHANNELS["qbar"].units["pa"]
+
+
+def _text(value: Any) -> str:
+    """MATLAB char data as a Python string ('' for an empty matrix)."""
+    if isinstance(value, str):
+        return value
+    arr = np.asarray(value)
+    if arr.size == 0:
+        return ""
+    if arr.dtype.kind in "US":
+        return "".join(str(x) for x in arr.ravel())
+    if arr.size == 1:
+        item = arr.item()
+        return str(int(item)) if isinstance(item, float) and item.is_integer() else str(item)
+    return str(value)
+
+
+def _number(value: Any) -> float | None:
+    """A finite scalar from a MATLAB field, or None if absent, empty or not a number."""
+    arr = np.asarray(value)
+    if arr.size != 1 or arr.dtype.kind not in "iuf":
+        return None
+    x = float(arr.item())
+    return x if math.isfinite(x) else None
+
+
+def _canonical_extra(unit: str) -> tuple[str, float] | None:
+    """Canonical unit and factor for an extra channel in format unit ``unit``."""
+    for spec in CHANNELS.values():
+        if unit in spec.units:
+            return spec.canonical, spec.units[unit]
+    return None
+
+
+def _is_constant(values: np.ndarray) -> bool:
+    return bool(np.all(values == values[0]))
+
+
+def import_sidpac(path: str | Path) -> Recording:
+    """Read a SIDPAC ``.mat`` flight-data file as a validated canonical recording.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.mat`` file (MATLAB v5, as written by SIDPAC).
+
+    Returns
+    -------
+    Recording
+        Named after the file stem; ``meta`` holds the format keys plus ``sidpac``
+        (file details, start time, c.g. position, column provenance, dropped columns)
+        and ``import_notes`` (every derivation or assumption made).
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    RecordingError
+        If the file lacks ``fds``/``fdata``/``t``, lengths disagree, a mapped
+        channel has an unexpected unit, ``qbar`` is missing and cannot be derived,
+        or the result breaks a rule of the format.
+    """
+    path = Path(path)
+    source = str(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{source}: no such SIDPAC file")
+    mat = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
+    fds = mat.get("fds")
+    if fds is None or not hasattr(fds, "varlab"):
+        raise RecordingError("no SIDPAC 'fds' struct with 'varlab'", source=source, key="fds",
+                             rule="not-sidpac")
+    fdata = np.asarray(mat["fdata"] if "fdata" in mat else getattr(fds, "fdata", []), dtype=np.float64)
+    t = np.asarray(mat["t"] if "t" in mat else getattr(fds, "t", []), dtype=np.float64).ravel()
+    labels = [_text(x).strip() for x in np.atleast_1d(fds.varlab)]
+    units = [_text(x).strip().strip("()").strip() for x in np.atleast_1d(fds.varunits)]
+    if fdata.ndim != 2 or fdata.shape[0] != t.size:
+        raise RecordingError(
+            f"fdata has shape {fdata.shape} but t has {t.size} samples",
+            source=source, key="fdata", rule="length-mismatch",
+        )
+    if not (len(labels) == len(units) == fdata.shape[1]):
+        raise RecordingError(
+            f"fds.varlab has {len(labels)} labels, fds.varunits {len(units)} units, fdata "
+            f"{fdata.shape[1]} columns",
+            source=source, key="fds.varlab", rule="length-mismatch",
+        )
+    seen_labels = [lab for lab in labels if lab]
+    dupes = sorted({lab for lab in seen_labels if seen_labels.count(lab) > 1})
+    if dupes:
+        raise RecordingError(f"labels used by more than one column: {dupes}", source=source,
+                             key="fds.varlab", rule="duplicate-quantity")
+
+    notes: list[str] = []
+    dropped: list[str] = []
+    provenance: dict[str, int | str] = {}
+    channels: dict[str, np.ndarray] = {"t_s": t}
+    mass_meta: dict[str, float] = {}
+    cg: dict[str, Any] = {}
+    geometry_columns: dict[str, float] = {}
+    rho: np.ndarray | None = None
+    start_time: float | None = None
+    blank = 0
+
+    for j, (label, unit) in enumerate(zip(labels, units)):
+        number = j + 1
+        values = fdata[:, j]
+        all_zero = not np.any(values)
+        where = f"column {number} ({label!r}, unit {unit!r})"
+        if not label:
+            if all_zero:
+                blank += 1
+            else:
+                dropped.append(f"column {number}: unlabelled, not all zero")
+            continue
+        if label == "time":
+            start_time = float(values[0])
+            continue
+        if label in _GEOMETRY_FIELDS:
+            if _is_constant(values):
+                geometry_columns[_GEOMETRY_FIELDS[label]] = float(values[0])
+            continue
+        if label in _CG_LABELS:
+            cg[f"{label}_in"] = (float(values[0]) if _is_constant(values) else
+                                 {"min": float(values.min()), "max": float(values.max()),
+                                  "mean": float(values.mean())})
+            continue
+        if label == "rho":
+            if not all_zero:
+                rho = values
+            dropped.append(f"{where}: air density is not a channel of the format")
+            continue
+        fmt_unit = _SIDPAC_UNITS.get(unit)
+        quantity = _LABEL_TO_QUANTITY.get(label)
+        if quantity is not None:
+            spec = CHANNELS[quantity]
+            if fmt_unit is None or fmt_unit not in spec.units:
+                raise RecordingError(
+                    f"unit {unit!r} cannot be converted to {spec.canonical!r} for {quantity!r}",
+                    source=source, key=where, rule="unknown-unit",
+                )
+            if quantity == "qbar" and all_zero:
+                notes.append(f"qbar ({where}) is all zero, impossible in flight: treated as absent.")
+                continue
+            if all_zero and quantity not in REQUIRED_QUANTITIES:
+                dropped.append(f"{where}: all zero")
+                continue
+            name = f"{quantity}_{fmt_unit}"
+            if quantity in _MASS_QUANTITIES and _is_constant(values):
+                mass_meta[spec.column] = float(values[0]) * spec.units[fmt_unit]
+                provenance[f"meta.mass.{spec.column}"] = number
+                continue
+            channels[name] = values
+            provenance[spec.column] = number
+            continue
+        # An extra channel: keep it in canonical units when the unit is known.
+        if all_zero:
+            dropped.append(f"{where}: all zero")
+            continue
+        if label in CHANNELS or label.startswith("truth_") or not label.replace("_", "").isalnum():
+            dropped.append(f"{where}: label cannot name an extra channel")
+            continue
+        if unit == "in":
+            canon, factor = "ft", _IN_FT
+        else:
+            conv = _canonical_extra(fmt_unit) if fmt_unit is not None else None
+            if conv is None:
+                dropped.append(f"{where}: unit not known to the format")
+                continue
+            canon, factor = conv
+        name = f"{label}_{canon}"
+        channels[name] = values * factor if factor != 1.0 else values
+        provenance[name] = number
+
+    if blank:
+        dropped.append(f"{blank} blank-labelled all-zero column(s)")
+
+    qbar_col = CHANNELS["qbar"].column
+    if qbar_col not in channels:
+        v = channels.get("V_fps")
+        if rho is not None and v is not None:
+            channels["qbar_psf"] = 0.5 * rho * v**2
+            notes.append("qbar_psf computed as 0.5*rho*V^2 from the file's rho and V columns.")
+        elif "mach_1" in channels and "h_ft" in channels:
+            mach, h = channels["mach_1"], channels["h_ft"]
+            try:
+                p_psf = isa_pressure_psf(h)
+            except ValueError as exc:
+                raise RecordingError(f"cannot derive qbar: {exc}", source=source,
+                                     key=_col_name(qbar_col), rule="missing-channel") from None
+            channels["qbar_psf"] = 0.5 * _GAMMA_AIR * p_psf * mach**2
+            note = ("qbar_psf computed as 0.5*gamma*p*M^2 (gamma 1.4) from the file's mach and alt, "
+                    "alt taken as pressure altitude and p the ISA static pressure at it")
+            if v is not None:
+                # Consistency check: the static temperature implied by V/M vs the ISA's.
+                a_fps = v / mach
+                t_implied = np.mean((a_fps * _FT_M) ** 2 / (_GAMMA_AIR * _ISA_R_J_PER_KG_K))
+                h_m = np.mean(h) * _FT_M
+                t_isa = _ISA_T0_K - _ISA_LAPSE_K_PER_M * min(h_m, _ISA_TROPOPAUSE_M)
+                note += (f"; check: static temperature implied by V/mach {t_implied:.1f} K, "
+                         f"ISA at mean altitude {t_isa:.1f} K")
+            notes.append(note + ".")
+        else:
+            raise RecordingError(
+                "dynamic pressure is missing (or all zero) and cannot be derived: needs rho and V, "
+                "or mach and alt",
+                source=source, key=_col_name(qbar_col), rule="missing-channel",
+            )
+        provenance[qbar_col] = "derived"
+
+    geometry: dict[str, float] = {}
+    for field_name, key in _GEOMETRY_FIELDS.items():
+        value = _number(getattr(fds, field_name, None))
+        if value is None:
+            value = _number(mat.get(field_name))
+        if value is None and key in geometry_columns:
+            value = geometry_columns[key]
+            notes.append(f"geometry {key} taken from fdata column {field_name!r} (fds.{field_name} absent).")
+        if value is not None:
+            geometry[key] = value
+            col = geometry_columns.get(key)
+            if col is not None and abs(col - value) > 1e-9 * abs(value):
+                notes.append(f"geometry {key}: fds.{field_name}={value!r} but fdata column has {col!r}; "
+                             "used fds.")
+
+    if start_time is not None and t.size:
+        dev = float(np.max(np.abs((fdata[:, labels.index("time")] - start_time) - (t - t[0]))))
+        if dev > 1e-6:
+            notes.append(f"the time column differs from t by up to {dev:.3g} s; t used.")
+
+    aircraft = _text(getattr(fds, "aircraft", "")).strip()
+    maneuver = _text(getattr(fds, "maneuver", "")).strip()
+    description = _text(getattr(fds, "description", "")).strip()
+    test_date = _text(getattr(fds, "test_date", "")).strip()
+    varying_mass = [CHANNELS[q].column for q in _MASS_QUANTITIES if CHANNELS[q].column in channels]
+    if varying_mass:
+        notes.append("time-varying mass properties kept as channels: " + ", ".join(varying_mass) + ".")
+    notes.append("ax/ay/az are SIDPAC's c.g.-referenced accelerations (accelerometer_ft = [0, 0, 0]); "
+                 "the measured ones are kept as axm_g/aym_g/azm_g when present.")
+    notes.append("thrust_offset_ft is not in the file; set to 0.0, i.e. any thrust moment stays in the "
+                 "moment coefficients, as in SIDPAC's own Cl/Cm/Cn columns.")
+    notes.append("control-surface signs copied from SIDPAC unchanged (not checked against JSBSim's).")
+    notes.append("Ixz copied unchanged: SIDPAC uses the seed's (Eqs. 3-5) sign convention.")
+
+    meta: dict[str, Any] = {
+        "format": FORMAT_ID,
+        "aircraft": aircraft,
+        "geometry": geometry,
+        "mass": mass_meta,
+        "sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]},
+        "thrust_offset_ft": 0.0,
+        "source": (f"SIDPAC file {path.name}: {aircraft}, maneuver {maneuver}, {description}, "
+                   f"{test_date or 'test date not recorded'}"),
+        "maneuver": description,
+        "sidpac": {
+            "file": path.name,
+            "aircraft": aircraft,
+            "maneuver": maneuver,
+            "description": description,
+            "test_date": test_date,
+            "pilot": _text(getattr(fds, "pilot", "")).strip(),
+            "created": _text(getattr(fds, "created", "")).strip(),
+            "start_time_s": start_time,
+            "cg_in": cg,
+            "columns": provenance,
+            "dropped": dropped,
+        },
+        "import_notes": notes,
+    }
+    frame = to_canonical(pd.DataFrame(channels), source)
+    return Recording(frame, meta, name=path.stem).validate(source)
+
+
+def _col_name(name: str) -> str:
+    return f"column {name!r}"
