@@ -47,6 +47,36 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--out", required=True, help="output recording (.csv or .parquet)")
     i.set_defaults(func="harness.commands:cmd_import")
 
+    e = sub.add_parser("estimate", help="estimate model parameters from a recording",
+                       description="Fit one equation (dependent = sum of regressors + bias) by equation "
+                                   "error in the time domain (ee-time), with smoothed regressors "
+                                   "(ee-smooth), in the frequency domain (ee-freq), or by output error "
+                                   "(oe). Prints a table; --json writes every number.")
+    e.add_argument("--recording", required=True, help="canonical recording (.csv/.parquet) or SIDPAC .mat")
+    e.add_argument("--dependent", required=True,
+                   help="CX, CY, CZ, Cl, Cm, Cn, CL or CD (from Eqs. 1-5, or the recording's own column)")
+    e.add_argument("--regressors", required=True,
+                   help="comma list: alpha, beta, qhat, phat, rhat, de, da, dr, dV, alphadot_hat, "
+                        "products a*b and powers a^2 ...")
+    e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe"])
+    e.add_argument("--errors", default="conventional", choices=["conventional", "colored"],
+                   help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40)")
+    e.add_argument("--max-lag", type=int, default=None, help="colored errors: largest lag (default: all)")
+    e.add_argument("--frequencies", default=None,
+                   help="ee-freq band F0:DF:F1 in Hz, or a comma list (default 0.20:0.04:1.20, Eq. 18)")
+    e.add_argument("--detrend", default="endpoints", choices=["endpoints", "lstsq"],
+                   help="ee-freq detrending: line through the end points (default) or least-squares line")
+    e.add_argument("--no-bias", action="store_true", help="no bias term (ee-freq never has one)")
+    e.add_argument("--reference", default="trim", choices=["trim", "first", "none"],
+                   help="regressors as perturbations from trim (default; raw where no trim is known), "
+                        "from the first sample, or raw (Eqs. 35-36)")
+    e.add_argument("--angular-acceleration", default="auto",
+                   choices=["auto", "recorded", "smooth-local", "smooth-fourier", "local-smooth"],
+                   help="pdot/qdot/rdot for Eqs. 3-5: recorded channels, or the seed's differentiation "
+                        "method 1, 2 or 3 (auto: recorded if present, else method 1)")
+    e.add_argument("--json", default=None, help="write the result to this JSON file")
+    e.set_defaults(func="harness.commands:cmd_estimate")
+
     b = sub.add_parser("bench", help="measure and print the benchmark table",
                        description="Time the project's main operations on this machine and print them.")
     b.add_argument("--repeat", type=int, default=7, help="repetitions per row (the best is kept)")

@@ -75,3 +75,23 @@ def cmd_demo(args: argparse.Namespace) -> int:
     print(truth_table(truth))
     print(f"\nRecording: {path.resolve()} (+ {path.with_suffix('.meta.json').name}), {rec.n} samples")
     return 0
+
+
+def cmd_estimate(args: argparse.Namespace) -> int:
+    from estimators.methods import make_estimator, parse_frequencies
+    from estimators.regressors import DataOptions, Equation
+    from harness.recording_io import read_recording
+
+    rec = read_recording(args.recording)
+    equation = Equation.parse(args.dependent, args.regressors, bias=not args.no_bias and args.method != "ee-freq")
+    data = DataOptions(angular_acceleration=args.angular_acceleration, reference=args.reference)
+    freqs = parse_frequencies(args.frequencies) if args.frequencies else None
+    estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
+                               detrend=args.detrend, data=data)
+    fit = estimator.fit(rec, equation)
+    print(f"{args.recording}: {equation.describe()}")
+    print(fit.summary())
+    if args.json:
+        write_json_atomic(args.json, fit.to_dict())
+        print(f"wrote {args.json}")
+    return 0

@@ -63,6 +63,9 @@ class Aircraft:
 
 def new_fdm(root: Path | None, name: str, dt: float) -> jsbsim.FGFDMExec:
     """Create a silent JSBSim instance and load aircraft ``name`` from ``root``."""
+    # JSBSim's banner is printed by the constructor unless its (process-wide) debug level
+    # is zero beforehand; no other JSBSim output is wanted either.
+    jsbsim.FGJSBBase().debug_lvl = 0
     fdm = jsbsim.FGFDMExec(None if root is None else str(root))
     fdm.set_debug_level(0)
     if not fdm.load_model(name):
