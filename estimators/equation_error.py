@@ -16,7 +16,7 @@ from estimators.fourier import finite_fourier_transform, seed_frequencies
 from estimators.least_squares import least_squares, r_squared
 from estimators.regressors import DataOptions, Equation, RegressionData, regression_data
 from estimators.result import ModelFit, collinearity
-from estimators.smoothing import optimal_fourier_smoother
+from estimators.smoothing import optimal_fourier_smoother, sine_series_filter
 from maneuvers.recording import Recording
 
 ERRORS = ("conventional", "colored")
@@ -47,8 +47,15 @@ class EquationErrorTime:
     ----------
     errors : ``'conventional'`` (Eq. 15, white residuals) or ``'colored'`` (Eqs. 37-41, the
         residual autocorrelation up to ``max_lag`` samples; all lags when None).
-    smooth_regressors : smooth every regressor with the optimal Fourier smoother first (the
+    smooth_regressors : smooth the regressors with the optimal Fourier smoother first (the
         seed's method 4 of §III.C), which removes most of the regressor-noise bias of Eq. 32.
+        One filter serves every column: each regressor's optimal (Wiener) weights are found
+        from its own spectrum, and their element-wise maximum (the least smoothing any
+        regressor asks for at each frequency) is applied to all regressors *and* to the
+        dependent variable. A common linear filter keeps ``z = Xθ`` exact, so noise-free
+        data are still fitted exactly (a square-wave δe smoothed on its own would no longer
+        match the sharp Cm it produced); noise above the regressors' band is removed from
+        both sides.
     data : how the recording becomes z and X (angular accelerations, perturbations).
     """
 
@@ -67,11 +74,15 @@ class EquationErrorTime:
 
     def fit(self, source: Recording | RegressionData, equation: Equation | None = None) -> ModelFit:
         d = _as_data(source, equation, self.data)
-        X = d.X
+        X, z = d.X, d.z
+        info: dict = {}
         if self.smooth_regressors and X.shape[1]:
-            X = np.column_stack([optimal_fourier_smoother(X[:, j], d.dt).smoothed for j in range(X.shape[1])])
-        A = np.column_stack([X, np.ones(len(d.z))]) if d.equation.bias else X
-        ls = least_squares(A, d.z, d.names)
+            fits = [optimal_fourier_smoother(X[:, j], d.dt) for j in range(X.shape[1])]
+            weights = np.max([f.weights for f in fits], axis=0)
+            X, z = sine_series_filter(X, weights), sine_series_filter(z, weights)
+            info["smoother_cutoff_hz"] = max(f.cutoff_hz for f in fits)
+        A = np.column_stack([X, np.ones(len(z))]) if d.equation.bias else X
+        ls = least_squares(A, z, d.names)
         if self.errors == "colored":
             cov = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag)
         else:
@@ -79,10 +90,10 @@ class EquationErrorTime:
         coll = collinearity(A, d.names, cov)
         return ModelFit(method=self.method, domain="time", dependent=d.equation.dependent, names=d.names,
                         params=ls.theta, cov=cov, residuals=ls.residuals, fitted=ls.fitted, n=len(d.z),
-                        s2=ls.s2, r2=r_squared(d.z, ls.residuals), errors=self.errors, collinearity=coll,
+                        s2=ls.s2, r2=r_squared(z, ls.residuals), errors=self.errors, collinearity=coll,
                         warnings=_warnings(d.names, coll, d.notes),
-                        info={"max_lag": self.max_lag if self.max_lag is not None else len(d.z) - 1}
-                        if self.errors == "colored" else {})
+                        info=info | ({"max_lag": self.max_lag if self.max_lag is not None else len(z) - 1}
+                                     if self.errors == "colored" else {}))
 
 
 def detrend(x: np.ndarray, how: str = "endpoints") -> np.ndarray:
