@@ -71,9 +71,44 @@ def flight_rows(repeat: int) -> list[BenchRow]:
     ]
 
 
+def _synthetic_regression(n: int, seed: int = 0):
+    """A short-period-like regression of ``n`` samples at 50 Hz with white output noise."""
+    import numpy as np
+
+    from estimators.regressors import RegressionData
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 0.02
+    X = np.column_stack([np.sin(0.9 * t) + 0.2 * np.sin(3.1 * t), 0.01 * np.cos(0.9 * t),
+                         np.sign(np.sin(0.5 * t)) * 0.017])
+    z = X @ np.array([-0.08, -5.9, -0.53]) + 0.002 + 1e-4 * rng.standard_normal(n)
+    return RegressionData.from_arrays(z, X, ("alpha", "qhat", "de"), 0.02, dependent="Cm")
+
+
+def estimator_rows(repeat: int) -> list[BenchRow]:
+    """Time per estimate of each method at N = 1,000 and N = 100,000 samples."""
+    from estimators.colored import colored_residual_covariance
+    from estimators.methods import make_estimator
+
+    out = []
+    for n in (1_000, 100_000):
+        d = _synthetic_regression(n)
+        reps = repeat if n <= 1_000 else max(1, repeat // 3)
+        for name, errors in (("ee-time", "conventional"), ("ee-time", "colored"), ("ee-smooth", "conventional"),
+                             ("ee-smooth", "colored"), ("ee-freq", "conventional")):
+            est = make_estimator(name, errors=errors)
+            tsec = best_of(lambda: est.fit(d), reps)
+            out.append(BenchRow(f"{name} {errors}, N = {n:,}", tsec * 1e3, "ms",
+                                "all lags" if errors == "colored" else ""))
+        fit = make_estimator("ee-time").fit(d)
+        A = d.design()
+        tsec = best_of(lambda: colored_residual_covariance(A, fit.residuals), reps)
+        out.append(BenchRow(f"colored covariance alone (Eq. 40, all lags), N = {n:,}", tsec * 1e3, "ms"))
+    return out
+
+
 def rows(repeat: int) -> list[BenchRow]:
     """All benchmark rows, in order."""
-    return flight_rows(repeat)
+    return flight_rows(repeat) + estimator_rows(repeat)
 
 
 def format_rows(table: list[BenchRow]) -> str:

@@ -141,24 +141,29 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     gain = loop.pitch_rate_gain if loop.kind == "closed" else 0.0
     de_prop = props["de"]
     de_cmd = (trim_pos["de"] + commands.get("de", np.zeros(n_frames + 1))).tolist()
-    # Surface writes only where a value changes: {frame: [(property, value), ...]}.
-    changes: dict[int, list[tuple[str, float]]] = {}
+    # Property nodes are read and written without parsing a path each time.
+    pm = fdm.get_property_manager()
+    node = pm.get_node
+    # Surface writes only where a value changes: {frame: [(setter, value), ...]}.
+    changes: dict[int, list[tuple[Callable[[float], None], float]]] = {}
     for s, cmd in commands.items():
         if gain and s == "de":
             continue  # written every frame with the feedback below
         values = trim_pos[s] + cmd
-        fdm[props[s]] = float(values[0])
+        setter = node(props[s]).set_double_value
+        setter(float(values[0]))
         for f in (np.flatnonzero(np.diff(values)) + 1).tolist():
-            changes.setdefault(f, []).append((props[s], float(values[f])))
+            changes.setdefault(f, []).append((setter, float(values[f])))
 
     read_props = ([p for _, p in _STATE_CHANNELS] + [props["de"], props["da"], props["dr"]]
                   + list(_FORCES) + list(_AERO) + ["aero/alphadot-rad_sec"])
     i_alpha = 1
     i_beta = 2
-    rows: list[tuple[float, ...]] = []
+    rows: list[list[float]] = []
+    getters = [node(p).get_double_value for p in read_props]
 
     def sample() -> None:
-        row = tuple([fdm[p] for p in read_props])
+        row = [g() for g in getters]
         rows.append(row)
         a, b, v = row[i_alpha], row[i_beta], row[0]
         # NaN fails every comparison, so "not (x < limit)" also catches it.
@@ -172,15 +177,17 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
 
     sample()
     run = fdm.run
+    set_de = node(de_prop).set_double_value
+    get_q = node("velocities/q-rad_sec").get_double_value
     f = 0
     for _ in range(n_samples - 1):
         for _ in range(n_sub):
             f += 1
             if f in changes:
-                for prop, v in changes[f]:
-                    fdm[prop] = v
+                for setter, v in changes[f]:
+                    setter(v)
             if gain:
-                fdm[de_prop] = de_cmd[f] + gain * fdm["velocities/q-rad_sec"]
+                set_de(de_cmd[f] + gain * get_q())
             run()
         sample()
 
