@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from maneuvers.recording import Recording
+from models.atmosphere import Turbulence
 
 
 @dataclass(frozen=True)
@@ -70,26 +71,6 @@ class ChannelNoise:
         return ChannelNoise(self.white_std * factor, self.colored_std * factor, self.colored_tau_s, self.band_hz,
                             self.bias * factor, self.scale * factor, self.quantum, self.skew_s,
                             self.spike_rate_hz, self.spike_std * factor)
-
-
-@dataclass(frozen=True)
-class Turbulence:
-    """Process noise: JSBSim's MIL-spec turbulence, flown per realization.
-
-    ``kind`` 'dryden' (JSBSim turb-type 3) or 'tustin' (4); ``severity`` the MIL-spec
-    probability-of-exceedance index JSBSim takes (1 light … 3 moderate … 5 severe); the wind at
-    20 ft (ft/s) sets the low-altitude intensity.
-    """
-
-    kind: str = "dryden"
-    severity: int = 1
-    wind_20ft_fps: float = 15.0
-
-    def __post_init__(self) -> None:
-        if self.kind not in ("dryden", "tustin"):
-            raise ValueError("turbulence kind must be 'dryden' or 'tustin'")
-        if not 0 <= self.severity <= 7:
-            raise ValueError("turbulence severity must be 0..7 (JSBSim's MIL-spec index)")
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import math
 
-from harness.noise import ChannelNoise, NoiseModel, Turbulence
+from harness.noise import ChannelNoise, NoiseModel
+from models.atmosphere import Turbulence
 
 DEG = math.pi / 180.0
 G0 = 32.17404855643

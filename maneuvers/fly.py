@@ -14,6 +14,7 @@ from maneuvers.recording import FORMAT_ID, Recording
 from models.aircraft import Aircraft, load_fdm
 from models.conditions import condition_for
 from models.exact import exact_truth_root
+from models.atmosphere import Turbulence
 from models.flight import FlightHistory, Loop, fly
 from models.trim import TrimPoint, trim
 from models.truth import Derivatives, excursion_from_history, truth_derivatives
@@ -42,6 +43,8 @@ class FlightSpec:
         :func:`models.flight.frames_per_sample`).
     loop : Loop
         Open loop, or the pitch-rate feedback δs = δs,cmd + K·q.
+    turbulence, turbulence_seed : Turbulence or None, int
+        Process noise flown with this flight (its own gusts for each seed).
     """
 
     input: InputSignal = field(default_factory=stabilator_2112)
@@ -51,6 +54,8 @@ class FlightSpec:
     sample_rate_hz: float = 50.0
     sim_rate_hz: float = 120.0
     loop: Loop = field(default_factory=Loop)
+    turbulence: Turbulence | None = None
+    turbulence_seed: int = 0
 
     @property
     def length_s(self) -> float:
@@ -80,7 +85,8 @@ def fly_history(spec: FlightSpec) -> tuple[FlightHistory, TrimPoint]:
     """Trim and fly ``spec``; the raw sampled histories and the trim point."""
     fdm, tp, _ = _load_and_trim(spec)
     hist = fly(fdm, spec.aircraft, tp, spec.input.deflections, spec.length_s,
-               sample_rate_hz=spec.sample_rate_hz, sim_rate_hz=spec.sim_rate_hz, loop=spec.loop)
+               sample_rate_hz=spec.sample_rate_hz, sim_rate_hz=spec.sim_rate_hz, loop=spec.loop,
+               turbulence=spec.turbulence, turbulence_seed=spec.turbulence_seed)
     return hist, tp
 
 
@@ -95,7 +101,8 @@ def fly_maneuver(spec: FlightSpec = FlightSpec()) -> Recording:
     """
     fdm, tp, kwargs = _load_and_trim(spec)
     hist = fly(fdm, spec.aircraft, tp, spec.input.deflections, spec.length_s,
-               sample_rate_hz=spec.sample_rate_hz, sim_rate_hz=spec.sim_rate_hz, loop=spec.loop)
+               sample_rate_hz=spec.sample_rate_hz, sim_rate_hz=spec.sim_rate_hz, loop=spec.loop,
+               turbulence=spec.turbulence, turbulence_seed=spec.turbulence_seed)
     cond = condition_for(spec.aircraft.model, spec.condition)
     truth = truth_derivatives(spec.aircraft, cond, excursion_from_history(hist.channels, tp), **kwargs)
     return to_recording(spec, hist, tp, truth)
@@ -127,6 +134,9 @@ def to_recording(spec: FlightSpec, hist: FlightHistory, tp: TrimPoint, truth: De
             "jsbsim": jsbsim.__version__, "model": spec.aircraft.model, "variant": spec.aircraft.variant,
             "rp_shift_in": spec.aircraft.rp_shift_in if spec.aircraft.variant == "unstable" else 0.0,
             "condition": tp.condition, "loop": {"kind": spec.loop.kind, "pitch_rate_gain": spec.loop.pitch_rate_gain},
+            "turbulence": None if spec.turbulence is None else {
+                "kind": spec.turbulence.kind, "severity": spec.turbulence.severity,
+                "wind_20ft_fps": spec.turbulence.wind_20ft_fps, "seed": spec.turbulence_seed},
             "sim_rate_hz": hist.sim_rate_hz, "frames": hist.frames, "sample_rate_hz": hist.sample_rate_hz,
             "rates": "body rates relative to the Earth (equal to the air-relative rates in still air)",
             "cg_in": list(tp.cg_in), "aero_rp_in": list(tp.aero_rp_in),

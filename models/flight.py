@@ -9,6 +9,7 @@ import jsbsim
 import numpy as np
 
 from models.aircraft import Aircraft
+from models.atmosphere import Turbulence, start_turbulence
 from models.trim import G0_FPS2, TrimPoint
 
 Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
@@ -102,7 +103,8 @@ def frames_per_sample(sample_rate_hz: float, sim_rate_hz: float) -> int:
 def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         deflections: Deflections, duration_s: float, *, sample_rate_hz: float = 50.0,
         sim_rate_hz: float = 120.0, loop: Loop = Loop(),
-        alpha_limit_rad: float = math.radians(40.0)) -> FlightHistory:
+        alpha_limit_rad: float = math.radians(40.0), turbulence: Turbulence | None = None,
+        turbulence_seed: int = 0) -> FlightHistory:
     """Fly a trimmed instance with the surfaces driven directly and record it.
 
     Parameters
@@ -116,6 +118,8 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     duration_s : float
         Length of the recording; samples at ``k / sample_rate_hz`` for ``k = 0 .. N-1`` with
         ``N = round(duration_s * sample_rate_hz) + 1``.
+    turbulence, turbulence_seed : Turbulence or None, int
+        Process noise flown from the first frame on (the trim is calm).
 
     Raises
     ------
@@ -130,6 +134,8 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     n_frames = (n_samples - 1) * n_sub
     fdm.set_dt(dt)
     fdm["simulation/models/FGFCS/enabled"] = 0
+    if turbulence is not None:
+        start_turbulence(fdm, turbulence, turbulence_seed)
 
     t_frames = np.arange(n_frames + 1) * dt
     commands = {s: np.asarray(v, dtype=float) for s, v in deflections(t_frames).items()}

@@ -169,3 +169,16 @@ def test_737_flies_and_is_consistent():
     measured = coefficients_from_recording(rec)
     for c in ("Cm", "Cl", "Cn", "CX", "CY", "CZ"):
         assert float(np.sqrt(np.mean((measured[c] - rec.truth[c]) ** 2))) <= 1e-4, c
+
+
+def test_turbulence_is_flown_per_seed_and_reproducible():
+    from models.atmosphere import Turbulence
+    turb = Turbulence("dryden", 3, 30.0)
+    a = fly_maneuver(FlightSpec(turbulence=turb, turbulence_seed=1))
+    b = fly_maneuver(FlightSpec(turbulence=turb, turbulence_seed=1))
+    c = fly_maneuver(FlightSpec(turbulence=turb, turbulence_seed=2))
+    calm = fly_maneuver(FlightSpec())
+    assert np.array_equal(a.channel("alpha"), b.channel("alpha"))
+    assert not np.array_equal(a.channel("alpha"), c.channel("alpha"))
+    assert np.std(a.channel("alpha") - calm.channel("alpha")) > math.radians(0.1)
+    assert a.meta["simulation"]["turbulence"]["seed"] == 1
