@@ -77,6 +77,23 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--json", default=None, help="write the result to this JSON file")
     e.set_defaults(func="harness.commands:cmd_estimate")
 
+    c = sub.add_parser("campaign", help="run a Monte Carlo campaign and print its scores",
+                       description="Run a campaign file (TOML; or the name of a built-in campaign: "
+                                   "regressor-noise, error-bounds, collinearity, multiple-maneuvers, "
+                                   "maneuver-design, nightly). Finished tasks are kept in OUT/tasks, so an "
+                                   "interrupted run resumes where it stopped.")
+    c.add_argument("file", help="campaign TOML file or built-in name")
+    c.add_argument("--out", required=True, help="output folder (results.parquet, scores.parquet, run.json)")
+    c.add_argument("--scheduler", default=None,
+                   help="'local' for a dask LocalCluster, or tcp://HOST:PORT of a Dask scheduler "
+                        "(default: a local process pool)")
+    c.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    c.add_argument("--realizations", type=int, default=None, help="override the file's realizations per cell")
+    c.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
+    c.add_argument("--history", default=None, help="also keep the scores in this history folder")
+    c.add_argument("--quiet", action="store_true", help="no progress display")
+    c.set_defaults(func="harness.commands:cmd_campaign")
+
     b = sub.add_parser("bench", help="measure and print the benchmark table",
                        description="Time the project's main operations on this machine and print them.")
     b.add_argument("--repeat", type=int, default=7, help="repetitions per row (the best is kept)")
@@ -90,8 +107,18 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _single_threaded_blas() -> None:
+    """One BLAS thread per process (before numpy loads): campaign workers already use every
+    core, and numpy's and scipy's separate OpenBLAS pools otherwise contend, making small
+    LAPACK calls up to 50x slower and timings irreproducible."""
+    import os
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``sidbench`` console script."""
+    _single_threaded_blas()
     args = _parser().parse_args(argv)
     module, name = args.func.split(":")
     import importlib

@@ -1,7 +1,12 @@
 """Shared fixtures: flights are flown once per test session (each costs ~0.1 s)."""
 from __future__ import annotations
 
-from pathlib import Path
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")  # see harness.cli._single_threaded_blas
+
+from pathlib import Path  # noqa: E402
 
 import pytest
 
