@@ -95,3 +95,24 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         write_json_atomic(args.json, fit.to_dict())
         print(f"wrote {args.json}")
     return 0
+
+
+def cmd_campaign(args: argparse.Namespace) -> int:
+    from harness.campaign import load_campaign
+    from harness.runner import run_campaign
+    from harness.scores import format_scores
+
+    campaign = load_campaign(args.file)
+    if args.realizations is not None:
+        if args.realizations < 1:
+            raise ValueError("--realizations must be at least 1")
+        campaign = campaign.with_realizations(args.realizations)
+    run = run_campaign(campaign, args.out, scheduler=args.scheduler, workers=args.workers, cache_dir=args.cache,
+                       history_dir=args.history, progress=not args.quiet)
+    m = run.meta
+    print(f"campaign {campaign.name}: {m['campaign']['cells']} cells x {campaign.realizations} realizations, "
+          f"{m['estimates']} estimates; {m['tasks_run']} tasks run, {m['tasks_resumed']} resumed; "
+          f"{m['wall_s']:.1f} s on {m['executor']}")
+    print(format_scores(run.scores))
+    print(f"\nwrote {run.out_dir / 'results.parquet'}, {run.out_dir / 'scores.parquet'}, {run.out_dir / 'run.json'}")
+    return 0
