@@ -210,9 +210,7 @@ def load_campaign(path: str | Path) -> Campaign:
         kind = spec.pop("kind", name)
         base = {k: spec.pop(k) for k in ("surface", "amplitude_deg", "unit_pulse_s") if k in spec}
         mdefs[name] = ManeuverDef(name, kind, **base, options=tuple(sorted(spec.items())))
-    maneuvers = []
-    for m in _list(grid, "maneuver", ["2-1-1-2"], where):
-        maneuvers.append(mdefs.get(m) or ManeuverDef(m, m))
+    maneuvers = [mdefs.get(m) or ManeuverDef(m, m) for m in _list(grid, "maneuver", ["2-1-1-2"], where)]
 
     ndefs = {}
     for name, spec in d.get("noise", {}).items():
@@ -233,12 +231,23 @@ def load_campaign(path: str | Path) -> Campaign:
         else:
             raise CampaignError(f"{where}: grid.noise {n!r} is neither a preset {PRESETS} nor a [noise.{n}] table")
 
-    flights = tuple(FlightKey(a, v, c, m, lp, flight_defaults.get("duration_s"),
-                              float(flight_defaults.get("sample_rate_hz", 50.0)))
-                    for a, v, c, m, lp in itertools.product(
-                        _list(grid, "aircraft", ["f16"], where), _list(grid, "variant", ["nominal"], where),
-                        _list(grid, "condition", ["seed-5deg"], where), maneuvers,
-                        [str(x) for x in _list(grid, "loop", ["open"], where)]))
+    duration = flight_defaults.get("duration_s")
+    rate = float(flight_defaults.get("sample_rate_hz", 50.0))
+    if "flights" in d:
+        # An explicit list of flights replaces the product of the grid's flight axes.
+        flights = []
+        for i, f in enumerate(d["flights"]):
+            m = f.get("maneuver", "2-1-1-2")
+            flights.append(FlightKey(f.get("aircraft", "f16"), f.get("variant", "nominal"),
+                                     f.get("condition", "seed-5deg"), mdefs.get(m) or ManeuverDef(m, m),
+                                     str(f.get("loop", "open")), f.get("duration_s", duration), rate))
+        flights = tuple(flights)
+    else:
+        flights = tuple(FlightKey(a, v, c, m, lp, duration, rate)
+                        for a, v, c, m, lp in itertools.product(
+                            _list(grid, "aircraft", ["f16"], where), _list(grid, "variant", ["nominal"], where),
+                            _list(grid, "condition", ["seed-5deg"], where), maneuvers,
+                            [str(x) for x in _list(grid, "loop", ["open"], where)]))
     from estimators.methods import METHODS
     methods = tuple(_list(grid, "method", ["ee-time"], where))
     for m in methods:
