@@ -22,6 +22,8 @@ from models.atmosphere import Turbulence
 
 BUILTIN_DIR = Path(__file__).resolve().parent / "campaigns"
 APPLY_TO = ("both", "regressors", "outputs")
+# Methods of a combined (multiple-maneuver) campaign, seed §III.F.
+COMBINED_METHODS = ("ee-concat", "ee-sequential", "ee-sequential-unequal", "ee-freq-combined")
 
 
 class CampaignError(ValueError):
@@ -67,8 +69,16 @@ class NoiseDef:
     scale: float = 1.0
     apply_to: str = "both"
     output: tuple[tuple[str, float], ...] = ()
+    flight_scales: tuple[float, ...] = ()
 
-    def model(self) -> NoiseModel:
+    def model(self, flight_index: int = 0) -> NoiseModel:
+        """The noise model (for a combined task, scaled for the ``flight_index``-th maneuver)."""
+        if self.flight_scales:
+            k = self.flight_scales[flight_index % len(self.flight_scales)]
+            return self._model().scaled(k) if k != 1.0 else self._model()
+        return self._model()
+
+    def _model(self) -> NoiseModel:
         base = preset(self.preset)
         m = base if self.scale == 1.0 else base.scaled(self.scale)
         out = {k: ChannelNoise(white_std=v) for k, v in self.output}
@@ -111,10 +121,16 @@ class Task:
     errors: tuple[str, ...]
     equations: tuple[Equation, ...]
     method_options: tuple[tuple[str, tuple[tuple[str, str | float | int], ...]], ...] = ()
+    extra_flights: tuple[FlightKey, ...] = ()
+
+    @property
+    def flights(self) -> tuple[FlightKey, ...]:
+        """All flights of the task (several for a combined multiple-maneuver task)."""
+        return (self.flight,) + self.extra_flights
 
     @property
     def task_id(self) -> str:
-        ident = f"{self.flight.digest()}|{self.noise.name}|{self.realization}"
+        ident = f"{'+'.join(f.digest() for f in self.flights)}|{self.noise.name}|{self.realization}"
         return hashlib.sha256(ident.encode()).hexdigest()[:20]
 
 
@@ -136,6 +152,7 @@ class Campaign:
     text_hash: str = ""
     extra: dict = field(default_factory=dict)
     method_options: tuple[tuple[str, tuple[tuple[str, str | float | int], ...]], ...] = ()
+    combine: bool = False
 
     def with_realizations(self, n: int) -> "Campaign":
         import dataclasses
@@ -143,6 +160,13 @@ class Campaign:
 
     def tasks(self) -> list[Task]:
         out = []
+        if self.combine:
+            for noise in self.noises:
+                for r in range(self.realizations):
+                    out.append(Task(self.name, self.flights[0], noise, r,
+                                    task_seed(self.seed, self.flights[0], noise, r), self.methods, self.errors,
+                                    self.equations, self.method_options, self.flights[1:]))
+            return out
         for flight, noise in itertools.product(self.flights, self.noises):
             for r in range(self.realizations):
                 out.append(Task(self.name, flight, noise, r, task_seed(self.seed, flight, noise, r),
@@ -151,7 +175,8 @@ class Campaign:
 
     @property
     def cell_count(self) -> int:
-        return len(self.flights) * len(self.noises) * len(self.methods) * len(self.errors) * len(self.equations)
+        flights = 1 if self.combine else len(self.flights)
+        return flights * len(self.noises) * len(self.methods) * len(self.errors) * len(self.equations)
 
 
 def task_seed(master: int, flight: FlightKey, noise: NoiseDef, realization: int) -> tuple[int, ...]:
@@ -221,7 +246,8 @@ def load_campaign(path: str | Path) -> Campaign:
             raise CampaignError(f"{where}: noise.{name}.apply_to must be one of {APPLY_TO}")
         ndefs[name] = NoiseDef(name, spec.get("preset", "none"), float(spec.get("scale", 1.0)),
                                spec.get("apply_to", "both"),
-                               tuple(sorted((k, float(v)) for k, v in spec.get("output", {}).items())))
+                               tuple(sorted((k, float(v)) for k, v in spec.get("output", {}).items())),
+                               tuple(float(x) for x in spec.get("flight_scales", ())))
     noises = []
     for n in _list(grid, "noise", ["none"], where):
         if n in ndefs:
@@ -249,10 +275,15 @@ def load_campaign(path: str | Path) -> Campaign:
                             _list(grid, "condition", ["seed-5deg"], where), maneuvers,
                             [str(x) for x in _list(grid, "loop", ["open"], where)]))
     from estimators.methods import METHODS
-    methods = tuple(_list(grid, "method", ["ee-time"], where))
+    combine = bool(d.get("combine", False))
+    allowed = COMBINED_METHODS if combine else METHODS
+    methods = tuple(_list(grid, "method", ["ee-concat" if combine else "ee-time"], where))
     for m in methods:
-        if m not in METHODS:
-            raise CampaignError(f"{where}: grid.method {m!r} is not one of {METHODS}")
+        if m not in allowed:
+            raise CampaignError(f"{where}: grid.method {m!r} is not one of {allowed}"
+                                + (" (a combined campaign)" if combine else ""))
+    if combine and len(flights) < 2:
+        raise CampaignError(f"{where}: combine = true needs at least two flights")
     errors = tuple(_list(grid, "errors", ["conventional"], where))
     for e in errors:
         if e not in ("conventional", "colored"):
@@ -263,7 +294,7 @@ def load_campaign(path: str | Path) -> Campaign:
         raise CampaignError(f"{where}: {exc}") from None
     method_options = []
     for m, opts in d.get("method_options", {}).items():
-        if m not in METHODS:
+        if m not in METHODS + COMBINED_METHODS:
             raise CampaignError(f"{where}: method_options.{m}: unknown method")
         bad = set(opts) - {"frequencies", "detrend", "max_lag"}
         if bad:
@@ -274,4 +305,4 @@ def load_campaign(path: str | Path) -> Campaign:
                     realizations=int(d["realizations"]), truth=truth, flights=flights, noises=tuple(noises),
                     methods=methods, errors=errors, equations=equations, path=str(p),
                     text_hash=hashlib.sha256(text.encode()).hexdigest(), extra=d.get("report", {}),
-                    method_options=tuple(method_options))
+                    method_options=tuple(method_options), combine=combine)

@@ -71,7 +71,7 @@ def run_campaign(campaign: Campaign, out_dir: str | Path, *, scheduler: str | No
     t0 = time.perf_counter()
     compute = 0.0
     with make_executor(scheduler, workers) as ex:
-        keys = sorted({t.flight for t in pending if t.noise.turbulence is None}, key=lambda k: k.digest())
+        keys = sorted({f for t in pending if t.noise.turbulence is None for f in t.flights}, key=lambda k: k.digest())
         missing = [k for k in keys if not (Path(cache) / "flights" / f"{k.digest()}.parquet").is_file()]
         bar = Progress(len(missing) + len(pending), f"{campaign.name}", enabled=progress)
         for _, seconds in ex.imap_unordered(prefly, missing, cache):
@@ -97,7 +97,7 @@ def run_campaign(campaign: Campaign, out_dir: str | Path, *, scheduler: str | No
         "tasks_run": len(pending), "tasks_resumed": len(tasks) - len(pending),
         "compute_s": compute,
         "harness_overhead": (1.0 - compute / (wall * min(workers, max(1, len(pending))))) if pending and wall > 0 else None,
-        "estimates": int((results["method"] != "crb").sum()),
+        "estimates": int((~results["method"].isin(["crb", "excursion", "check"])).sum()),
     }
     write_run(out_dir, results, scores, meta)
     if history_dir is not None:

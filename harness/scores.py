@@ -66,7 +66,7 @@ def score(results: pd.DataFrame, truth: str = "local") -> pd.DataFrame:
     if truth not in ("local", "fit"):
         raise ValueError("truth must be 'local' or 'fit'")
     truth_col = f"truth_{truth}"
-    est = results[~results["method"].isin(["crb", "excursion"])]
+    est = results[~results["method"].isin(["crb", "excursion", "check"])]
     crb = results[results["method"] == "crb"].groupby(FLIGHT_NOISE, dropna=False)["std_error"].first()
     rows = []
     for key, g in est.groupby(CELL, sort=True, dropna=False):

@@ -49,6 +49,17 @@ def cached_flight(key: FlightKey, cache_dir: str | Path) -> Recording:
     return rec
 
 
+SURFACES = ("de", "da", "dr")
+
+
+def excited_equations(rec: Recording, equations: tuple[Equation, ...]) -> tuple[Equation, ...]:
+    """The equations whose control surfaces this flight moves (a longitudinal input says
+    nothing about Cn: such equations are not fitted rather than reported as failures)."""
+    moved = {s for s in SURFACES if rec.has(s) and np.ptp(rec.channel(s)) > 0}
+    return tuple(eq for eq in equations
+                 if all(r in moved for r in eq.regressors if r in SURFACES))
+
+
 def estimator_options(task: Task, method: str) -> dict:
     """Keyword options of :func:`estimators.methods.make_estimator` from the campaign file."""
     from estimators.methods import parse_frequencies
@@ -120,6 +131,8 @@ def _failure_rows(base: dict, eq: Equation, rec: Recording, message: str) -> lis
 def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
     """All rows (one per method × errors × equation × parameter) of one task, and the time
     the task's flights and estimates took (for the harness-overhead figure)."""
+    if task.extra_flights:
+        return run_combined_task(task, cache_dir)
     t_start = time.perf_counter()
     noise_model = task.noise.model()
     turb = task.noise.turbulence
@@ -135,10 +148,12 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
               "noise": task.noise.name, "realization": task.realization, "seed": json.dumps(list(task.seed))}
     rows: list[dict] = []
     oe_fits: dict[str, tuple] = {}
+    equations = excited_equations(clean, task.equations)
+    prepared: dict[Equation, RegressionData] = {}  # one build per equation, shared by the methods
     for method in task.methods:
         errs = task.errors if method in TIME_DOMAIN else (("cramer-rao",) if method == "oe" else ("conventional",))
         for errors in errs:
-            for eq in task.equations:
+            for eq in equations:
                 base = common | {"method": method, "errors": errors, "equation": eq.describe(),
                                  "dependent": eq.dependent}
                 try:
@@ -151,7 +166,9 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
                             oe_fits[model] = (OutputError(model=model).fit(src, eq), time.perf_counter() - t0)
                         fit, elapsed = oe_fits[model]
                     else:
-                        d = _regression(clean, noisy, eq, task.noise.apply_to, task, noise_model)
+                        if eq not in prepared:
+                            prepared[eq] = _regression(clean, noisy, eq, task.noise.apply_to, task, noise_model)
+                        d = prepared[eq]
                         est = make_estimator(method, errors=errors if method in TIME_DOMAIN else "conventional",
                                              **estimator_options(task, method))
                         t0 = time.perf_counter()
@@ -161,7 +178,7 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
                 except (SingularRegressorsError, EquationError, ValueError, np.linalg.LinAlgError) as exc:
                     rows += _failure_rows(base, eq, clean, f"{type(exc).__name__}: {exc}")
     if task.realization == 0:
-        rows += crb_rows(common, clean, noise_model, task.equations)
+        rows += crb_rows(common, clean, noise_model, equations)
         rows += excursion_rows(common, clean)
     return pd.DataFrame(rows, columns=ROW_COLUMNS), time.perf_counter() - t_start
 
@@ -272,3 +289,65 @@ def excursion_rows(common: dict, clean: Recording) -> list[dict]:
                       "estimate": v, "std_error": float("nan"), "truth_local": float("nan"),
                       "truth_fit": float("nan"), "time_s": float("nan"), "max_corr": float("nan"), "ok": True,
                       "message": ""} for k, v in excursions(clean).items()]
+
+
+def run_combined_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
+    """A multiple-maneuver task (seed §III.F): every flight gets its own noise (its own
+    stream, scaled by ``noise.flight_scales``); the equations are fitted by concatenation
+    (Eq. 42), sequential a-priori combination with equal (Eqs. 47, 49) and unequal variances
+    (Eqs. 45, 48) and frequency-domain combination. A row of method 'check' records the largest
+    relative difference between the concatenated and the sequential estimates."""
+    from estimators.multiple import fit_concatenated, fit_frequency_combined, fit_sequential
+    t_start = time.perf_counter()
+    cleans, noisies, models = [], [], []
+    for i, key in enumerate(task.flights):
+        clean = cached_flight(key, cache_dir)
+        model = task.noise.model(i)
+        seed = task.seed + (i,)
+        noisies.append(apply_noise(clean, model, seed) if (model.channels or model.drop) else clean)
+        cleans.append(clean)
+        models.append((model, seed))
+    labels = "+".join(k.maneuver.name for k in task.flights)
+    f0 = task.flight
+    common = {"task_id": task.task_id, "campaign": task.campaign, "flight": labels, "aircraft": f0.aircraft,
+              "variant": f0.variant, "condition": f0.condition, "maneuver": labels, "loop": f0.loop,
+              "noise": task.noise.name, "realization": task.realization, "seed": json.dumps(list(task.seed))}
+    rows: list[dict] = []
+    for eq in task.equations:
+        datasets = []
+        for clean, noisy, (model, seed) in zip(cleans, noisies, models):
+            sub = Task(task.campaign, f0, task.noise, task.realization, seed, (), (), ())
+            datasets.append(_regression(clean, noisy, eq, task.noise.apply_to, sub, model))
+        fits = {}
+        for method in task.methods:
+            errs = task.errors if method == "ee-concat" else ("conventional",)
+            for errors in errs:
+                base = common | {"method": method, "errors": errors, "equation": eq.describe(),
+                                 "dependent": eq.dependent}
+                t0 = time.perf_counter()
+                try:
+                    if method == "ee-concat":
+                        fit = fit_concatenated(datasets, errors=errors)
+                    elif method == "ee-sequential":
+                        fit = fit_sequential(datasets, equal_variances=True)
+                    elif method == "ee-sequential-unequal":
+                        fit = fit_sequential(datasets, equal_variances=False)
+                    else:
+                        fit = fit_frequency_combined(datasets, **{k: v for k, v in estimator_options(task, method).items()
+                                                                 if k in ("frequencies_hz", "detrend")})
+                except (SingularRegressorsError, EquationError, ValueError, np.linalg.LinAlgError) as exc:
+                    rows += _failure_rows(base, eq, cleans[0], f"{type(exc).__name__}: {exc}")
+                    continue
+                fits[(method, errors)] = fit
+                rows += _rows_for_fit(base, fit, eq, cleans[0], time.perf_counter() - t0)
+        a, b = fits.get(("ee-concat", "conventional")), fits.get(("ee-sequential", "conventional"))
+        if a is not None and b is not None:
+            rel = float(np.max(np.abs(a.params - b.params) / np.maximum(np.abs(a.params), 1e-300)))
+            rel_cov = float(np.max(np.abs(a.cov - b.cov)) / np.max(np.abs(a.cov)))
+            for name, v in (("max_rel_diff_estimates", rel), ("max_rel_diff_covariance", rel_cov)):
+                rows.append(common | {"method": "check", "errors": "", "equation": eq.describe(),
+                                      "dependent": eq.dependent, "parameter": name, "estimate": v,
+                                      "std_error": float("nan"), "truth_local": float("nan"),
+                                      "truth_fit": float("nan"), "time_s": float("nan"),
+                                      "max_corr": float("nan"), "ok": True, "message": ""})
+    return pd.DataFrame(rows, columns=ROW_COLUMNS), time.perf_counter() - t_start
