@@ -103,12 +103,70 @@ def estimator_rows(repeat: int) -> list[BenchRow]:
         A = d.design()
         tsec = best_of(lambda: colored_residual_covariance(A, fit.residuals), reps)
         out.append(BenchRow(f"colored covariance alone (Eq. 40, all lags), N = {n:,}", tsec * 1e3, "ms"))
+        oe_data = _short_period_oe_data(n)
+        from estimators.output_error import OutputError
+        oe = OutputError(model="short-period")
+        tsec = best_of(lambda: oe.fit(oe_data), reps)
+        out.append(BenchRow(f"oe short period, N = {n:,}", tsec * 1e3, "ms", "Gauss-Newton from equation-error start"))
+    return out
+
+
+def _short_period_oe_data(n: int, seed: int = 0):
+    """Noisy outputs of the seed's Eq. 33 model (F-16 values) under repeated 2-1-1-2 inputs."""
+    import numpy as np
+
+    from estimators.output_error_models import FlightConstants, OutputErrorData
+    from estimators.state_space import short_period_dimensional, short_period_matrices, simulate_linear
+    fc = FlightConstants(qbar=149.0, V=420.0, S=300.0, cbar=11.32, b=30.0, m=641.0, Ix=12289.0, Iy=57108.0,
+                         Iz=67072.0, Ixz=1060.0)
+    dim = short_period_dimensional(-3.62, -31.4, 0.19, -0.081, -5.93, -0.529, fc.qbar, fc.S, fc.cbar, fc.m,
+                                   fc.Iy, fc.V)
+    A, B, C, D = short_period_matrices(**dim, V_o=fc.V)
+    t = np.arange(n) * 0.02
+    phase = t % 20.0
+    u = np.radians(1.0) * (((phase >= 1) & (phase < 3)) * 1.0 - ((phase >= 3) & (phase < 4))
+                           + ((phase >= 4) & (phase < 5)) - ((phase >= 5) & (phase < 7)))
+    _, y = simulate_linear(A, B, C, D, u, 0.02)
+    rng = np.random.default_rng(seed)
+    z = y + rng.standard_normal(y.shape) * np.array([np.radians(0.1), np.radians(0.14), 0.03])
+    return OutputErrorData(t=t, u=u.reshape(-1, 1), z=z, flight=fc)
+
+
+def campaign_rows(realizations: int = 20) -> list[BenchRow]:
+    """Throughput and overhead of a campaign on the local pool, and LocalCluster scaling."""
+    import tempfile
+    from pathlib import Path
+
+    from harness.campaign import load_campaign
+    from harness.runner import run_campaign
+
+    campaign = load_campaign("regressor-noise").with_realizations(realizations)
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        cache = Path(tmp) / "cache"
+        warm = run_campaign(campaign.with_realizations(1), Path(tmp) / "warm", workers=2, cache_dir=cache,
+                            progress=False)  # flights flown and cached once
+        run = run_campaign(campaign, Path(tmp) / "pool", workers=2, cache_dir=cache, progress=False)
+        m = run.meta
+        out.append(BenchRow(f"campaign throughput, local pool 2 workers ({campaign.name}, {m['campaign']['tasks']} tasks)",
+                            m["estimates"] / m["wall_s"], "est/s", f"{m['estimates']} estimates in {m['wall_s']:.1f} s"))
+        out.append(BenchRow("harness overhead (1 - compute / (wall x workers))", 100 * (m["harness_overhead"] or 0.0),
+                            "%", "target < 20 %"))
+        walls = {}
+        for w in (1, 2):
+            r = run_campaign(campaign, Path(tmp) / f"dask{w}", scheduler="local", workers=w, cache_dir=cache,
+                             progress=False)
+            walls[w] = r.meta["wall_s"]
+            out.append(BenchRow(f"dask LocalCluster, {w} worker{'s' if w > 1 else ''}", walls[w], "s",
+                                f"{r.meta['estimates'] / walls[w]:.0f} est/s (cluster start-up included)"))
+        out.append(BenchRow("LocalCluster scaling 1 -> 2 workers", walls[1] / walls[2], "x", "2 cores"))
+        del warm
     return out
 
 
 def rows(repeat: int) -> list[BenchRow]:
     """All benchmark rows, in order."""
-    return flight_rows(repeat) + estimator_rows(repeat)
+    return flight_rows(repeat) + estimator_rows(repeat) + campaign_rows()
 
 
 def format_rows(table: list[BenchRow]) -> str:

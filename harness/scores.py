@@ -39,8 +39,8 @@ def _cell_scores(g: pd.DataFrame, truth_col: str) -> dict:
         return out
     mean = float(est.mean())
     std = float(est.std(ddof=1)) if n > 1 else float("nan")
-    if std == 0.0:
-        std = float("nan")  # no scatter (e.g. noise-free): ratios against it are undefined
+    if std <= 1e-12 * max(abs(truth), 1e-300) or std == 0.0:
+        std = float("nan")  # no scatter (noise-free): ratios against it are undefined
     mcse = std / np.sqrt(n) if n > 1 else float("nan")
     bias = mean - truth
     covered = int(np.sum(np.abs(est - truth) <= COVERAGE_K * se)) if np.isfinite(truth) else 0

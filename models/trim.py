@@ -94,8 +94,11 @@ def read_trim_point(fdm: jsbsim.FGFDMExec, condition: str, surfaces: dict[str, s
 def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) -> TrimPoint:
     """Trim ``fdm`` (freshly loaded) wings-level at ``condition`` and freeze its mass.
 
-    Full trim (``do_trim(1)``) with the engine running; the aircraft's reference-point rule
-    is applied before trimming. Fuel is frozen afterwards so mass and c.g. stay put.
+    Longitudinal trim (``do_trim(0)``: throttle, stabilator, α) with the engine running,
+    which is all a symmetric aircraft needs wings level; if the lateral accelerations are not
+    then zero (an asymmetric aircraft or variant) the full six-axis trim (``do_trim(1)``)
+    follows. The aircraft's reference-point rule is applied before trimming. Fuel is frozen
+    afterwards so mass and c.g. stay put.
 
     Raises
     ------
@@ -109,7 +112,11 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     if place_reference_point(fdm, aircraft):
         fdm.run_ic()
     try:
-        fdm.do_trim(1)
+        fdm.do_trim(0)
+        lateral = max(abs(fdm["accelerations/pdot-rad_sec2"]), abs(fdm["accelerations/rdot-rad_sec2"]),
+                      abs(fdm["accelerations/vdot-ft_sec2"]))
+        if lateral > 1e-6:
+            fdm.do_trim(1)
     except jsbsim.TrimFailureError as exc:
         hint = ""
         if aircraft.model == "f16" and 420.0 < condition.V_fps < 432.0 and abs(condition.h_ft - 10_000) < 2_000:

@@ -190,3 +190,27 @@ def test_every_builtin_campaign_runs_from_the_command_line(name, tmp_path, capsy
 def test_builtin_campaign_names_are_the_six_of_the_issue():
     assert sorted(p.stem for p in BUILTIN_DIR.glob("*.toml")) == sorted(
         ["regressor-noise", "error-bounds", "collinearity", "multiple-maneuvers", "maneuver-design", "nightly"])
+
+
+def test_scores_against_hand_computed_values():
+    from harness.scores import score
+    est = np.array([1.0, 1.2, 0.8, 1.1, 0.9])
+    se = np.array([0.1, 0.1, 0.1, 0.01, 0.2])
+    base = {"campaign": "c", "aircraft": "f16", "variant": "v", "condition": "x", "maneuver": "m", "loop": "open",
+            "noise": "n", "method": "ee-time", "errors": "conventional", "equation": "e", "dependent": "Cm",
+            "parameter": "Cm_alpha", "truth_local": 1.05, "truth_fit": 1.0, "time_s": 0.01, "max_corr": 0.5,
+            "ok": True}
+    df = pd.DataFrame([base | {"realization": i, "estimate": e, "std_error": s} for i, (e, s) in enumerate(zip(est, se))])
+    sc = score(df, "local").iloc[0]
+    std = est.std(ddof=1)
+    assert sc["mean"] == pytest.approx(1.0) and sc["bias"] == pytest.approx(-0.05)
+    assert sc["bias_pct"] == pytest.approx(-0.05 / 1.05 * 100)
+    assert sc["bias_z"] == pytest.approx(-0.05 / (std / math.sqrt(5)))
+    assert sc["rmse"] == pytest.approx(math.sqrt(np.mean((est - 1.05) ** 2)))
+    assert sc["se_ratio"] == pytest.approx(se.mean() / std)
+    # covered: |e - 1.05| <= 2 se -> 1.0 yes, 1.2 yes (0.15 <= 0.2), 0.8 no, 1.1 no (0.05 > 0.02), 0.9 yes
+    assert sc["coverage"] == pytest.approx(3 / 5)
+    from scipy.stats import binomtest
+    ci = binomtest(3, 5).proportion_ci(method="exact")
+    assert sc["coverage_lo"] == pytest.approx(ci.low) and sc["coverage_hi"] == pytest.approx(ci.high)
+    assert score(df, "fit").iloc[0]["truth"] == 1.0
