@@ -214,3 +214,18 @@ def test_scores_against_hand_computed_values():
     ci = binomtest(3, 5).proportion_ci(method="exact")
     assert sc["coverage_lo"] == pytest.approx(ci.low) and sc["coverage_hi"] == pytest.approx(ci.high)
     assert score(df, "fit").iloc[0]["truth"] == 1.0
+
+
+def test_scheduler_address_of_a_running_cluster(tmp_path):
+    """``--scheduler tcp://HOST:PORT``: a scheduler started elsewhere (here a LocalCluster on
+    loopback) runs the campaign with the same numbers as the local pool."""
+    from distributed import LocalCluster
+    campaign = load_campaign(_write(tmp_path, OLS_CASE.format(n=4)))
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        remote = run_campaign(campaign, tmp_path / "remote", scheduler=cluster.scheduler_address, workers=2,
+                              cache_dir=tmp_path / "c1", progress=False)
+    pool = run_campaign(campaign, tmp_path / "pool", workers=2, cache_dir=tmp_path / "c2", progress=False)
+    assert "dask scheduler tcp://127.0.0.1" in remote.meta["executor"]
+    pd.testing.assert_frame_equal(remote.results[DETERMINISTIC], pool.results[DETERMINISTIC], check_exact=True)
