@@ -73,7 +73,6 @@ def linear_flight(key: FlightKey, fly_nominal) -> Recording:
     CZ = tc["CZ"] + dCZ
     CX = np.full(n, tc["CX"])
     Cm = tc["Cm"] + dCm
-    a0 = nominal.channel("alpha")[0]
     alpha_abs = trim["alpha_rad"] + alpha
     data = {
         "t_s": t, "V_fps": np.full(n, V), "alpha_rad": alpha_abs, "beta_rad": beta,
@@ -94,7 +93,6 @@ def linear_flight(key: FlightKey, fly_nominal) -> Recording:
         "truth_CL_1": -CZ * np.cos(alpha_abs) + CX * np.sin(alpha_abs),
         "truth_alphadot_rps": alphadot,
     }
-    del a0
     # Only these derivatives are the linear models' own; their local and fit values coincide.
     own = {f"{co}_{v}" for co in ("CZ", "Cm") for v in ("alpha", "qhat", "de")} | set(lat)
     meta["truth"] = dict(meta["truth"])

@@ -95,6 +95,16 @@ def _regression(clean: Recording, noisy: Recording, eq: Equation, apply_to: str,
     return RegressionData(eq, z, dx.X, dx.t, dx.dt, dx.notes)
 
 
+NAN = float("nan")
+ROW_DEFAULTS = {"errors": "", "equation": "", "dependent": "", "estimate": NAN, "std_error": NAN,
+                "truth_local": NAN, "truth_fit": NAN, "time_s": NAN, "max_corr": NAN, "ok": True, "message": ""}
+
+
+def _row(common: dict, **fields) -> dict:
+    """One result row: the task's identity, the defaults, then ``fields``."""
+    return common | ROW_DEFAULTS | fields
+
+
 def max_correlation(fit) -> float:
     """Largest pairwise |r| (Eq. 50) among the fit's non-bias parameters."""
     keep = [i for i, n in enumerate(fit.names) if not n.startswith("bias")]
@@ -112,9 +122,8 @@ def _rows_for_fit(base: dict, fit, eq: Equation, rec: Recording, elapsed: float)
         if name != "bias" and not name.startswith(eq.dependent + "_"):
             continue
         tl, tf = _truth(rec, name)
-        rows.append(base | {"parameter": name, "estimate": float(est), "std_error": float(se),
-                            "truth_local": tl, "truth_fit": tf, "time_s": elapsed, "max_corr": mc,
-                            "ok": True, "message": ""})
+        rows.append(_row(base, parameter=name, estimate=float(est), std_error=float(se), truth_local=tl,
+                         truth_fit=tf, time_s=elapsed, max_corr=mc))
     return rows
 
 
@@ -122,9 +131,8 @@ def _failure_rows(base: dict, eq: Equation, rec: Recording, message: str) -> lis
     rows = []
     for r in eq.regressors:
         tl, tf = _truth(rec, f"{eq.dependent}_{r}")
-        rows.append(base | {"parameter": f"{eq.dependent}_{r}", "estimate": float("nan"), "std_error": float("nan"),
-                            "truth_local": tl, "truth_fit": tf, "time_s": float("nan"), "max_corr": float("nan"),
-                            "ok": False, "message": message[:300]})
+        rows.append(_row(base, parameter=f"{eq.dependent}_{r}", truth_local=tl, truth_fit=tf, ok=False,
+                         message=message[:300]))
     return rows
 
 
@@ -208,58 +216,14 @@ def crb_rows(common: dict, clean: Recording, noise_model, equations: tuple[Equat
             cov = cramer_rao_bound(clean, model, theta, np.array(var))
         except (ValueError, np.linalg.LinAlgError):
             continue
-        crb_names = names
         for eq in equations:
             if _model_of(eq) != model:
                 continue
-            for name, v in zip(crb_names, np.sqrt(np.diag(cov))):
+            for name, v in zip(names, np.sqrt(np.diag(cov))):
                 if name.startswith(eq.dependent + "_"):
                     tl, tf = _truth(clean, name)
-                    rows.append(common | {"method": "crb", "errors": "", "equation": eq.describe(),
-                                          "dependent": eq.dependent, "parameter": name, "estimate": float("nan"),
-                                          "std_error": float(v), "truth_local": tl, "truth_fit": tf,
-                                          "time_s": float("nan"), "max_corr": float("nan"), "ok": True,
-                                          "message": ""})
-    return rows
-
-
-def prefly(key: FlightKey, cache_dir: str) -> float:
-    """Fly and cache one clean flight; the time it took."""
-    t0 = time.perf_counter()
-    cached_flight(key, cache_dir)
-    return time.perf_counter() - t0
-
-
-def crb_rows(common: dict, clean: Recording, noise_model, equations: tuple[Equation, ...]) -> list[dict]:
-    """Cramér-Rao bounds at the true parameters with the true output noise (method 'crb')."""
-    from estimators.output_error import cramer_rao_bound
-    from estimators.output_error_models import parameter_names
-    outputs = {"short-period": ("alpha", "q", "az"), "lateral": ("beta", "p", "r", "phi", "ay")}
-    chans = noise_model.channel_map
-    rows = []
-    for model in sorted({_model_of(eq) for eq in equations}):
-        var = [chans[o].white_std ** 2 + chans[o].colored_std ** 2 if o in chans else 0.0 for o in outputs[model]]
-        if min(var) <= 0:
-            continue  # the bound needs noise on every output
-        names = parameter_names(model)
-        theta = {n: _truth(clean, n)[0] for n in names}
-        theta = {n: (0.0 if np.isnan(v) else v) for n, v in theta.items()}
-        try:
-            cov = cramer_rao_bound(clean, model, theta, np.array(var))
-        except (ValueError, np.linalg.LinAlgError):
-            continue
-        crb_names = names
-        for eq in equations:
-            if _model_of(eq) != model:
-                continue
-            for name, v in zip(crb_names, np.sqrt(np.diag(cov))):
-                if name.startswith(eq.dependent + "_"):
-                    tl, tf = _truth(clean, name)
-                    rows.append(common | {"method": "crb", "errors": "", "equation": eq.describe(),
-                                          "dependent": eq.dependent, "parameter": name, "estimate": float("nan"),
-                                          "std_error": float(v), "truth_local": tl, "truth_fit": tf,
-                                          "time_s": float("nan"), "max_corr": float("nan"), "ok": True,
-                                          "message": ""})
+                    rows.append(_row(common, method="crb", equation=eq.describe(), dependent=eq.dependent,
+                                     parameter=name, std_error=float(v), truth_local=tl, truth_fit=tf))
     return rows
 
 
@@ -285,10 +249,7 @@ def excursions(rec: Recording) -> dict[str, float]:
 
 def excursion_rows(common: dict, clean: Recording) -> list[dict]:
     """The flight's excursions from trim as rows of method 'excursion'."""
-    return [common | {"method": "excursion", "errors": "", "equation": "", "dependent": "", "parameter": k,
-                      "estimate": v, "std_error": float("nan"), "truth_local": float("nan"),
-                      "truth_fit": float("nan"), "time_s": float("nan"), "max_corr": float("nan"), "ok": True,
-                      "message": ""} for k, v in excursions(clean).items()]
+    return [_row(common, method="excursion", parameter=k, estimate=v) for k, v in excursions(clean).items()]
 
 
 def run_combined_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
@@ -345,9 +306,6 @@ def run_combined_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
             rel = float(np.max(np.abs(a.params - b.params) / np.maximum(np.abs(a.params), 1e-300)))
             rel_cov = float(np.max(np.abs(a.cov - b.cov)) / np.max(np.abs(a.cov)))
             for name, v in (("max_rel_diff_estimates", rel), ("max_rel_diff_covariance", rel_cov)):
-                rows.append(common | {"method": "check", "errors": "", "equation": eq.describe(),
-                                      "dependent": eq.dependent, "parameter": name, "estimate": v,
-                                      "std_error": float("nan"), "truth_local": float("nan"),
-                                      "truth_fit": float("nan"), "time_s": float("nan"),
-                                      "max_corr": float("nan"), "ok": True, "message": ""})
+                rows.append(_row(common, method="check", equation=eq.describe(), dependent=eq.dependent,
+                                 parameter=name, estimate=v))
     return pd.DataFrame(rows, columns=ROW_COLUMNS), time.perf_counter() - t_start
