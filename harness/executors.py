@@ -56,7 +56,7 @@ class DaskExecutor(Executor):
         self.cluster = None
         if scheduler == "local":
             self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                        host="127.0.0.1", dashboard_address=None)
+                                        host="127.0.0.1", dashboard_address=":0")
             self.client = Client(self.cluster)
             self.description = f"dask LocalCluster, {workers} workers"
         else:

@@ -222,7 +222,7 @@ def test_scheduler_address_of_a_running_cluster(tmp_path):
     from distributed import LocalCluster
     campaign = load_campaign(_write(tmp_path, OLS_CASE.format(n=4)))
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster:
+                      dashboard_address=":0") as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
         remote = run_campaign(campaign, tmp_path / "remote", scheduler=cluster.scheduler_address, workers=2,
                               cache_dir=tmp_path / "c1", progress=False)
