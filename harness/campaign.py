@@ -122,6 +122,7 @@ class Task:
     equations: tuple[Equation, ...]
     method_options: tuple[tuple[str, tuple[tuple[str, str | float | int], ...]], ...] = ()
     extra_flights: tuple[FlightKey, ...] = ()
+    method_factories: tuple[tuple[str, str], ...] = ()
 
     @property
     def flights(self) -> tuple[FlightKey, ...]:
@@ -153,6 +154,7 @@ class Campaign:
     extra: dict = field(default_factory=dict)
     method_options: tuple[tuple[str, tuple[tuple[str, str | float | int], ...]], ...] = ()
     combine: bool = False
+    method_factories: tuple[tuple[str, str], ...] = ()
 
     def with_realizations(self, n: int) -> "Campaign":
         import dataclasses
@@ -170,7 +172,8 @@ class Campaign:
         for flight, noise in itertools.product(self.flights, self.noises):
             for r in range(self.realizations):
                 out.append(Task(self.name, flight, noise, r, task_seed(self.seed, flight, noise, r),
-                                self.methods, self.errors, self.equations, self.method_options))
+                                self.methods, self.errors, self.equations, self.method_options,
+                                method_factories=self.method_factories))
         return out
 
     @property
@@ -305,4 +308,5 @@ def load_campaign(path: str | Path) -> Campaign:
                     realizations=int(d["realizations"]), truth=truth, flights=flights, noises=tuple(noises),
                     methods=methods, errors=errors, equations=equations, path=str(p),
                     text_hash=hashlib.sha256(text.encode()).hexdigest(), extra=d.get("report", {}),
-                    method_options=tuple(method_options), combine=combine)
+                    method_options=tuple(method_options), combine=combine,
+                    method_factories=tuple(sorted(d.get("method_factories", {}).items())))

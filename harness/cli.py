@@ -1,7 +1,9 @@
 """The ``sidbench`` command line.
 
-Each subcommand is a function ``cmd_<name>(args) -> int``; heavy imports happen inside them
-so that ``--help`` stays quick. Errors the user can fix (a malformed recording, a trim that
+Each subcommand is a function ``cmd_<name>(args) -> int`` named here by module path and
+imported only when run, so that ``--help`` stays quick; the report-writing subcommands live in
+``reports.commands`` (the harness never imports the reports package, which sits to its right
+in the data flow). Errors the user can fix (a malformed recording, a trim that
 fails, a diverging flight, a bad option) print one message naming the cause and exit 2.
 """
 from __future__ import annotations
@@ -9,6 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from harness.flying import add_flight_options
 
@@ -99,11 +102,58 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--repeat", type=int, default=7, help="repetitions per row (the best is kept)")
     b.set_defaults(func="harness.bench:cmd_bench")
 
-    d = sub.add_parser("demo", help="the main job: fly the default maneuver, print its truth",
+    d = sub.add_parser("demo", help="the main job: fly, print the truth, run a quick campaign, write a report",
                        description="Fly the seed's default maneuver (F-16, stabilator 2-1-1-2, 1 deg, 1 s "
-                                   "unit pulse) and print the truth table and where the recording went.")
+                                   "unit pulse), print its truth table, run a quick regressor-noise campaign and "
+                                   "write OUT/report.html (+ .md, .json).")
     d.add_argument("--out", default="out", help="output folder (default: out)")
-    d.set_defaults(func="harness.commands:cmd_demo")
+    d.add_argument("--realizations", type=int, default=100, help="realizations of the demo campaign (default 100)")
+    d.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    d.set_defaults(func="reports.commands:cmd_demo")
+
+    r = sub.add_parser("report", help="turn campaign output into HTML, Markdown and JSON reports",
+                       description="Write report.html (self-contained), report.md and report.json for a campaign "
+                                   "output folder; --kind benchmark ranks the methods over one or more folders.")
+    r.add_argument("dirs", nargs="+", help="campaign output folder(s)")
+    r.add_argument("--kind", default="campaign", choices=["campaign", "benchmark"])
+    r.add_argument("--out", default=None, help="where to write (default: the first folder)")
+    r.set_defaults(func="reports.commands:cmd_report")
+
+    n = sub.add_parser("nightly", help="run the nightly campaign, compare, gate, report",
+                       description="Run the nightly campaign, append it to the history, compare it with the previous "
+                                   "run and the declared gates, and write nightly.html/.md/.json. Exits 1 when a gate "
+                                   "fails, naming the method and parameter.")
+    n.add_argument("--out", required=True, help="output folder of tonight's run")
+    n.add_argument("--history", default=None, help="history folder (default: OUT/../history)")
+    n.add_argument("--campaign", default="nightly", help="campaign to run (default: nightly)")
+    n.add_argument("--gates", default=str(Path(__file__).resolve().parent / "campaigns" / "nightly-gates.toml"),
+                   help="gates file (TOML)")
+    n.add_argument("--realizations", type=int, default=None)
+    n.add_argument("--nights", type=int, default=30, help="runs shown in the trends (default 30)")
+    n.add_argument("--workers", type=int, default=None)
+    n.add_argument("--scheduler", default=None)
+    n.add_argument("--cache", default=None)
+    n.add_argument("--quiet", action="store_true")
+    n.set_defaults(func="reports.commands:cmd_nightly")
+
+    v = sub.add_parser("review-maneuvers", help="maneuver design review of candidate inputs",
+                       description="Fly candidate inputs on an aircraft and condition, score them by Monte Carlo, "
+                                   "and write review.html: input spectra against the modes, predicted Cramér-Rao "
+                                   "bounds, regressor correlations (|r| > 0.9 flagged), excursions, accuracy, and a "
+                                   "recommendation per parameter group.")
+    v.add_argument("--aircraft", default="f16", choices=["f16", "737"])
+    v.add_argument("--condition", default="seed-5deg")
+    v.add_argument("--maneuvers", default="doublet,2-1-1-2,3-2-1-1,sweep-linear,multisine",
+                   help="comma list of input kinds (matched 6 s of motion and amplitude)")
+    v.add_argument("--axis", default="both", choices=["lon", "lat", "both"])
+    v.add_argument("--noise", default="realistic")
+    v.add_argument("--realizations", type=int, default=30)
+    v.add_argument("--out", required=True)
+    v.add_argument("--workers", type=int, default=None)
+    v.add_argument("--scheduler", default=None)
+    v.add_argument("--cache", default=None)
+    v.add_argument("--quiet", action="store_true")
+    v.set_defaults(func="reports.commands:cmd_review_maneuvers")
     return p
 
 

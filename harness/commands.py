@@ -61,20 +61,20 @@ def cmd_import(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_demo(args: argparse.Namespace) -> int:
+def fly_default(out: Path) -> Path:
+    """Fly the seed's default maneuver, print its truth table, write the recording."""
     from harness.recording_io import write_recording
     from maneuvers.fly import FlightSpec, fly_maneuver, truth_table
     from models.truth import Derivatives
 
-    out = Path(args.out)
     spec = FlightSpec()
     rec = fly_maneuver(spec)
     truth = Derivatives.from_dict(rec.meta["truth"])
-    path = write_recording(rec, out / "f16_stabilator_2112.csv")
+    path = write_recording(rec, Path(out) / "f16_stabilator_2112.csv")
     print(f"Flew {spec.describe()}.\n")
     print(truth_table(truth))
     print(f"\nRecording: {path.resolve()} (+ {path.with_suffix('.meta.json').name}), {rec.n} samples")
-    return 0
+    return path
 
 
 def cmd_estimate(args: argparse.Namespace) -> int:

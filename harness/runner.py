@@ -100,6 +100,8 @@ def run_campaign(campaign: Campaign, out_dir: str | Path, *, scheduler: str | No
         "estimates": int((~results["method"].isin(["crb", "excursion", "check"])).sum()),
     }
     write_run(out_dir, results, scores, meta)
+    from harness.artifacts import write_artifacts
+    write_artifacts(campaign, tasks, out_dir, cache)
     if history_dir is not None:
         append_history(Path(history_dir), scores, meta)
     return CampaignRun(results, scores, meta, out_dir)

@@ -60,6 +60,18 @@ def excited_equations(rec: Recording, equations: tuple[Equation, ...]) -> tuple[
                  if all(r in moved for r in eq.regressors if r in SURFACES))
 
 
+def _estimator(task: Task, method: str, errors: str):
+    """The estimator for ``method``: the registry's, or a campaign's ``[method_factories]``
+    override (``module:callable`` taking the same keywords), e.g. to plant a regression."""
+    kwargs = dict(errors=errors if method in TIME_DOMAIN else "conventional", **estimator_options(task, method))
+    factory = dict(task.method_factories).get(method)
+    if factory is None:
+        return make_estimator(method, **kwargs)
+    import importlib
+    module, _, name = factory.partition(":")
+    return getattr(importlib.import_module(module), name)(method, **kwargs)
+
+
 def estimator_options(task: Task, method: str) -> dict:
     """Keyword options of :func:`estimators.methods.make_estimator` from the campaign file."""
     from estimators.methods import parse_frequencies
@@ -101,8 +113,8 @@ ROW_DEFAULTS = {"errors": "", "equation": "", "dependent": "", "estimate": NAN, 
 
 
 def _row(common: dict, **fields) -> dict:
-    """One result row: the task's identity, the defaults, then ``fields``."""
-    return common | ROW_DEFAULTS | fields
+    """One result row: the defaults, overridden by the task's identity, then by ``fields``."""
+    return ROW_DEFAULTS | common | fields
 
 
 def max_correlation(fit) -> float:
@@ -177,8 +189,7 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
                         if eq not in prepared:
                             prepared[eq] = _regression(clean, noisy, eq, task.noise.apply_to, task, noise_model)
                         d = prepared[eq]
-                        est = make_estimator(method, errors=errors if method in TIME_DOMAIN else "conventional",
-                                             **estimator_options(task, method))
+                        est = _estimator(task, method, errors)
                         t0 = time.perf_counter()
                         fit = est.fit(d)
                         elapsed = time.perf_counter() - t0

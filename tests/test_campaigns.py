@@ -94,6 +94,9 @@ def test_dask_localcluster_matches_the_local_pool_bit_for_bit(tmp_path):
     assert "LocalCluster" in dask.meta["executor"]
     serial = run_campaign(campaign, tmp_path / "serial", workers=1, cache_dir=tmp_path / "cache3", progress=False)
     a, b, c = (r.results[DETERMINISTIC] for r in (pool, dask, serial))
+    est = pool.results[pool.results["method"] == "ee-time"]
+    assert set(est["errors"]) == {"conventional", "colored"}
+    assert set(est["equation"]) == {"Cm = Cm_alpha + Cm_qhat + Cm_de + bias"} and set(est["dependent"]) == {"Cm"}
     pd.testing.assert_frame_equal(a, b, check_exact=True)
     pd.testing.assert_frame_equal(a, c, check_exact=True)
 

@@ -118,12 +118,8 @@ def test_local_derivative_rejects_bad_windows(kwargs):
 
 
 def _random_band_limited(rng, t, n_sines=20):
-    """Random sum of sines with frequencies in (0, 1] Hz and its exact derivative."""
-    freqs = 1.0 - rng.uniform(0.0, 1.0, n_sines)  # (0, 1]
-    amps = rng.normal(size=n_sines)
-    phases = rng.uniform(0.0, 2 * np.pi, n_sines)
-    arg = 2 * np.pi * np.multiply.outer(t, freqs) + phases
-    return (amps * np.sin(arg)).sum(axis=1), (amps * 2 * np.pi * freqs * np.cos(arg)).sum(axis=1)
+    from harness.studies import random_band_limited
+    return random_band_limited(rng, t, n_sines)
 
 
 def test_smooth_derivative_interface():
@@ -185,18 +181,9 @@ def test_seed_fig1_experiment(capsys):
     derivative) over the interior divided by the RMS of the true derivative
     there.  All smoothing uses the automatic cut-off, as in the seed paper.
     """
-    n_runs, noise_to_signal = 100, 0.10
-    t = np.arange(0, 22.0 + DT / 2, DT)
-    inner = interior_mask(t.size, DT, 1.0)
-    errors = np.empty((n_runs, 3))
-    for run in range(n_runs):
-        rng = np.random.default_rng(run)
-        x, dx = _random_band_limited(rng, t)
-        z = x + noise_to_signal * np.sqrt(np.mean(x**2)) * rng.normal(size=t.size)
-        ref = dx[inner]
-        for j, method in enumerate((1, 2, 3)):
-            d = smooth_derivative(z, DT, method, end_buffer_s=1.0)
-            errors[run, j] = np.sqrt(np.mean((d - ref) ** 2) / np.mean(ref**2))
+    from harness.studies import differentiation_study
+    df = differentiation_study(100, seed=0, noise_to_signal=0.10, dt=DT)
+    errors = df.pivot(index="sequence", columns="method", values="rms_error_pct").to_numpy() / 100
     mean = errors.mean(axis=0)
     with capsys.disabled():
         print(
