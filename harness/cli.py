@@ -126,7 +126,7 @@ def _parser() -> argparse.ArgumentParser:
     n.add_argument("--out", required=True, help="output folder of tonight's run")
     n.add_argument("--history", default=None, help="history folder (default: OUT/../history)")
     n.add_argument("--campaign", default="nightly", help="campaign to run (default: nightly)")
-    n.add_argument("--gates", default=str(Path(__file__).resolve().parent / "campaigns" / "nightly-gates.toml"),
+    n.add_argument("--gates", default=str(Path(__file__).resolve().parent / "nightly-gates.toml"),
                    help="gates file (TOML)")
     n.add_argument("--realizations", type=int, default=None)
     n.add_argument("--nights", type=int, default=30, help="runs shown in the trends (default 30)")

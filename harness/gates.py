@@ -1,6 +1,6 @@
 """Nightly gates: declared claims checked against the scores, and movement since last run.
 
-Gates live in a TOML file (default ``harness/campaigns/nightly-gates.toml``):
+Gates live in a TOML file (default ``harness/nightly-gates.toml``):
 
 - ``kind = "coverage"``: coverage of the ±2σ interval within [low, high] for the listed
   methods — allowing for its Monte Carlo uncertainty: a cell fails only when its exact 95 %
@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import norm
 
-DEFAULT_GATES = Path(__file__).resolve().parent / "campaigns" / "nightly-gates.toml"
+DEFAULT_GATES = Path(__file__).resolve().parent / "nightly-gates.toml"
 
 
 @dataclass(frozen=True)

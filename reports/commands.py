@@ -14,7 +14,7 @@ def write_all(report, out_dir: Path, stem: str = "report") -> Path:
     """HTML, Markdown and JSON side by side; returns the HTML path."""
     out_dir = Path(out_dir)
     html = write_html(report, out_dir / f"{stem}.html")
-    write_markdown(report, out_dir / f"{stem}.md")
+    write_markdown(report, out_dir / f"{stem}.md", html_name=html.name)
     write_json(report, out_dir / f"{stem}.json")
     return html
 
