@@ -16,6 +16,16 @@ def history_frame(history: list) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
+def gate_summary(gates: pd.DataFrame) -> pd.DataFrame:
+    """Per gate: cells checked, passed, failed, and the worst value seen."""
+    if gates.empty:
+        return pd.DataFrame(columns=["gate", "cells", "passed", "failed", "limit"])
+    g = gates.groupby(["gate", "kind"], sort=False)
+    out = g.agg(cells=("passed", "size"), passed=("passed", "sum"), limit=("limit", "first")).reset_index()
+    out["failed"] = out["cells"] - out["passed"]
+    return out[["gate", "kind", "cells", "passed", "failed", "limit"]]
+
+
 def nightly_report(out: CampaignOutput, gates: pd.DataFrame, history: list, previous: dict | None,
                    nights: int = 30) -> Report:
     """The nightly document; ``status`` is 'fail' when any gate fails."""
@@ -28,13 +38,18 @@ def nightly_report(out: CampaignOutput, gates: pd.DataFrame, history: list, prev
         summary.append(f"... and {len(failed) - 8} more failures (see the gate table).")
     summary += summary_lines(out)[:4]
     gt = gates.sort_values("passed", kind="stable").reset_index(drop=True) if not gates.empty else gates
-    hl = tuple((i, "passed", "bad" if not r["passed"] else "good") for i, r in gt.head(300).iterrows())
+    full = gt.drop(columns=["kind", "message"]).head(300) if not gt.empty else gt
+    hl = tuple((i, "passed", "bad" if not r["passed"] else "good") for i, r in full.iterrows())
     moved = gates[(gates["kind"] == "movement") & ~gates["passed"]] if not gates.empty else gates
+    tables = [Table("Gate summary", gate_summary(gates), "One row per gate: how many gated cells pass.",
+                    tuple((i, "failed", "bad") for i, r in gate_summary(gates).iterrows() if r["failed"]))]
+    if len(failed):
+        tables.append(Table("Failures", failed[["gate", "message"]].reset_index(drop=True),
+                            "Each names the method, noise, maneuver and parameter that broke the claim."))
+    tables.append(Table("All gated cells", full, "Failures first."))
     sections = [
         Section("Gates", ("Each gate states a claim the methods meet, with limits that allow for Monte Carlo "
-                          "uncertainty; failures first.",),
-                (Table("Gate results", gt.drop(columns=["kind"]).head(300),
-                       "passed = False names the method, noise and parameter that broke the claim.", hl),)),
+                          "uncertainty (see harness/nightly-gates.toml).",), tuple(tables)),
         Section("Regressions since the previous run",
                 (("None: no score moved beyond its Monte Carlo uncertainty." if moved.empty else
                   f"{len(moved)} scores moved beyond their Monte Carlo uncertainty.") if previous else
