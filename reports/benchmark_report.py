@@ -81,5 +81,11 @@ def benchmark_report(outputs: list[CampaignOutput]) -> Report:
     ]
     numbers = {"overall": ov.replace({np.nan: None}).to_dict(orient="records"),
                "rankings": rankings(s).replace({np.nan: None}).to_dict(orient="records")}
-    return Report(title="Method benchmarking", kind="benchmark", provenance=provenance(outputs[0].meta),
+    prov = provenance(outputs[0].meta) | {
+        "campaign": ", ".join(o.meta["campaign"]["name"] for o in outputs),
+        "file": ", ".join(str(o.path) for o in outputs),
+        "sha256": ", ".join((o.meta["campaign"].get("sha256") or "")[:12] for o in outputs),
+        "seed": ", ".join(str(o.meta.get("seed")) for o in outputs),
+        "start": min(o.meta.get("start", "") for o in outputs), "end": max(o.meta.get("end", "") for o in outputs)}
+    return Report(title="Method benchmarking", kind="benchmark", provenance=prov,
                   summary=tuple(summary), sections=tuple(sections), numbers=numbers)

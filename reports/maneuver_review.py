@@ -62,8 +62,9 @@ def maneuver_review(out: CampaignOutput, corr: pd.DataFrame) -> Report:
     sections = [
         Section("Recommendation", tuple(rec)),
         Section("Inputs against the aircraft's modes", ("Input power should cover the modes' frequencies.",),
-                (Table("Modes at trim", out.modes, "Natural frequency and damping of the linear models at trim."),)
-                if not out.modes.empty else (),
+                (Table("Modes at trim", out.modes.drop(columns=["flight"]).drop_duplicates().reset_index(drop=True),
+                       "Natural frequency and damping of the linear models at trim (the same for every candidate: "
+                       "they share the trim point)."),) if not out.modes.empty else (),
                 tuple(f for f in (F.fig_input_spectra(out.flights, out.modes), F.fig_time_histories(out.flights))
                       if f is not None)),
         Section("Cramér-Rao bounds predicted before flying",
