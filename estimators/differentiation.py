@@ -28,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy import signal
 
+from estimators.smoothing import as_record as _as_record
 from estimators.smoothing import optimal_fourier_smoother
 
 __all__ = [
@@ -155,16 +156,6 @@ def local_polynomial_derivative(
     return signal.savgol_filter(
         a, int(window), int(order), deriv=1, delta=dt, axis=axis, mode="interp"
     )
-
-
-def _as_record(x: npt.ArrayLike) -> np.ndarray:
-    a = np.asarray(x)
-    if np.iscomplexobj(a):
-        raise ValueError("x must be real")
-    a = a.astype(float)
-    if a.ndim != 1:
-        raise ValueError("x must be a 1-D record")
-    return a
 
 
 def smooth_derivative(

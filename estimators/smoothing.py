@@ -115,13 +115,19 @@ class FourierSmoothing:
         return slope + 0.5 * sp_fft.dct(amp, type=1)
 
 
-def _validate(x: npt.ArrayLike, dt: float) -> tuple[np.ndarray, float]:
+def as_record(x: npt.ArrayLike) -> np.ndarray:
+    """``x`` as a real 1-D float record; a clear ValueError otherwise."""
     a = np.asarray(x)
     if np.iscomplexobj(a):
         raise ValueError("x must be real")
     a = a.astype(float)
     if a.ndim != 1:
         raise ValueError("x must be a 1-D record")
+    return a
+
+
+def _validate(x: npt.ArrayLike, dt: float) -> tuple[np.ndarray, float]:
+    a = as_record(x)
     if a.size < _MIN_SAMPLES:
         raise ValueError(f"x needs at least {_MIN_SAMPLES} samples, got {a.size}")
     if np.isnan(a).any():

@@ -164,9 +164,47 @@ def campaign_rows(realizations: int = 20) -> list[BenchRow]:
     return out
 
 
+def report_rows(target_rows: int = 100_000) -> list[BenchRow]:
+    """Scoring and writing a campaign report from a results table of ``target_rows`` rows.
+
+    A small nightly run is replicated (realizations renumbered) up to the target size; the
+    timing covers scoring, every figure and the HTML, Markdown and JSON files. The reports
+    package is loaded by module path, as the command line does (the harness never imports it)."""
+    import importlib
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    import pandas as pd
+
+    from harness.campaign import load_campaign
+    from harness.runner import run_campaign
+    from harness.scores import score
+    from harness.store import write_parquet
+
+    with tempfile.TemporaryDirectory() as tmp:
+        run = run_campaign(load_campaign("nightly").with_realizations(4), Path(tmp) / "small", workers=2,
+                           cache_dir=Path(tmp) / "cache", progress=False)
+        base = run.results
+        copies = max(1, -(-target_rows // len(base)))
+        big = pd.concat([base.assign(realization=base["realization"] + 4 * k) for k in range(copies)],
+                        ignore_index=True)
+        out = Path(tmp) / "big"
+        shutil.copytree(run.out_dir, out, ignore=shutil.ignore_patterns("tasks"))
+        write_parquet(big, out / "results.parquet")
+        t0 = time.perf_counter()
+        write_parquet(score(big, "local"), out / "scores.parquet")
+        load = importlib.import_module("reports.load")
+        report = importlib.import_module("reports.campaign_report").campaign_report(load.read_output(out))
+        importlib.import_module("reports.commands").write_all(report, out)
+        seconds = time.perf_counter() - t0
+    return [BenchRow(f"campaign report from a {len(big):,}-row results table", seconds, "s",
+                     "scores + all figures + HTML/Markdown/JSON; target < 30 s")]
+
+
 def rows(repeat: int) -> list[BenchRow]:
     """All benchmark rows, in order."""
-    return flight_rows(repeat) + estimator_rows(repeat) + campaign_rows()
+    return flight_rows(repeat) + estimator_rows(repeat) + campaign_rows() + report_rows()
 
 
 def format_rows(table: list[BenchRow]) -> str:

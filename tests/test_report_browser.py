@@ -43,27 +43,8 @@ CHECK_SCRIPT = """<script>
 """
 
 
-@dataclass(frozen=True)
-class FakeFigure:
-    """Stands in for reports.figures.FigureOut (same four attributes)."""
-
-    name: str
-    caption: str
-    png: bytes
-    alt: str
-
-
-def _png(slope: float) -> bytes:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(3, 2), dpi=40)
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
-    ax.plot([0, 1], [0, slope])
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    return buf.getvalue()
+from test_report_render import FakeFigure  # noqa: E402  (shared test doubles)
+from test_report_render import tiny_png as _png  # noqa: E402
 
 
 def _report() -> Report:
