@@ -6,7 +6,6 @@ import io
 import json
 import math
 import re
-import time
 from dataclasses import dataclass
 from html.parser import HTMLParser
 
@@ -298,20 +297,19 @@ def test_long_tables_are_truncated_with_a_note(tmp_path):
     assert "see the HTML report" in md
 
 
-def test_hundred_thousand_rows_render_fast(tmp_path):
+def test_hundred_thousand_rows_are_truncated_in_html_and_kept_in_json(tmp_path):
+    """Correctness only; the time it takes is measured by `sidbench bench`."""
     n = 100_000
     frame = pd.DataFrame({"t": np.arange(n) * 0.02, "alpha": np.random.default_rng(1)
                           .normal(size=n), "flag": np.arange(n) % 7})
     report = Report("Big", "benchmark", {"seed": 1}, ("big table",),
                     (Section("Data", tables=(Table("All samples", frame),)),),
                     {"alpha": frame["alpha"].to_numpy()})
-    start = time.perf_counter()
     html = write_html(report, tmp_path / "big.html")
     write_markdown(report, tmp_path / "big.md")
     data_path = write_json(report, tmp_path / "big.json")
-    elapsed = time.perf_counter() - start
-    assert elapsed < 10, f"{elapsed:.2f} s"
     assert html.stat().st_size < 200_000
+    assert "Showing the first 300 of 100,000 rows." in html.read_text(encoding="utf-8")
     data = json.loads(data_path.read_text(encoding="utf-8"))
     assert len(data["numbers"]["alpha"]) == n  # every number given is kept
 
