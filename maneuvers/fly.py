@@ -14,6 +14,7 @@ from maneuvers.recording import FORMAT_ID, Recording
 from models.aircraft import Aircraft, load_fdm
 from models.conditions import condition_for
 from models.exact import exact_truth_root
+from models.hidden import hidden_root, needs_copy
 from models.atmosphere import Turbulence
 from models.flight import FlightHistory, Loop, fly
 from models.trim import TrimPoint, trim
@@ -76,6 +77,11 @@ def _load_and_trim(spec: FlightSpec) -> tuple[jsbsim.FGFDMExec, TrimPoint, dict]
     kwargs: dict = {}
     if spec.aircraft.variant == "exact-truth":
         root, name = exact_truth_root(spec.aircraft, cond)
+        kwargs = {"root": root, "name": name}
+    elif spec.aircraft.hidden and needs_copy(spec.aircraft.hidden):
+        if spec.aircraft.variant != "nominal":
+            raise ValueError("hidden effects are added to the nominal aircraft only")
+        root, name = hidden_root(spec.aircraft, cond)
         kwargs = {"root": root, "name": name}
     fdm = load_fdm(spec.aircraft, 1.0 / 120.0, **kwargs)
     return fdm, trim(fdm, spec.aircraft, cond), kwargs
@@ -140,6 +146,9 @@ def to_recording(spec: FlightSpec, hist: FlightHistory, tp: TrimPoint, truth: De
             "sim_rate_hz": hist.sim_rate_hz, "frames": hist.frames, "sample_rate_hz": hist.sample_rate_hz,
             "rates": "body rates relative to the Earth (equal to the air-relative rates in still air)",
             "cg_in": list(tp.cg_in), "aero_rp_in": list(tp.aero_rp_in),
+            # the concealed physics and its true size (the recording's channels and
+            # sensors metadata do not reveal it)
+            "hidden_effects": [e.describe() for e in spec.aircraft.hidden],
         },
     }
     return Recording(data=pd.DataFrame(data), meta=meta, name="flight").validate("simulated flight")

@@ -44,6 +44,7 @@ class Aircraft:
     model: str = "f16"
     variant: str = "nominal"
     rp_shift_in: float = 8.0
+    hidden: tuple = ()  # models.hidden.HiddenEffect: concealed physics for the discrepancy diagnosis
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
@@ -58,7 +59,8 @@ class Aircraft:
 
     @property
     def label(self) -> str:
-        return self.model if self.variant == "nominal" else f"{self.model}/{self.variant}"
+        base = self.model if self.variant == "nominal" else f"{self.model}/{self.variant}"
+        return base + "".join(f"+{e.effect}" for e in self.hidden)
 
 
 def new_fdm(root: Path | None, name: str, dt: float) -> jsbsim.FGFDMExec:
@@ -93,7 +95,12 @@ def load_fdm(aircraft: Aircraft, dt: float, *, root: Path | None = None,
             raise ValueError("the exact-truth variant is built per flight condition: "
                              "use models.exact.exact_truth_root() and pass root= and name=")
         root, name = nominal_root(aircraft.model)
-    return new_fdm(root, name or aircraft.model, dt)
+    fdm = new_fdm(root, name or aircraft.model, dt)
+    for e in aircraft.hidden:
+        if e.effect == "control_delay":
+            from models.hidden import delay_property
+            fdm[delay_property(e.surface)] = 0.0  # the aerodynamics read it from the first run_ic
+    return fdm
 
 
 def place_reference_point(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> bool:

@@ -10,6 +10,7 @@ import numpy as np
 
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence, start_turbulence
+from models.hidden import delay_deltas, delay_property, frames_of, offset_accelerometer
 from models.trim import G0_FPS2, TrimPoint
 
 Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
@@ -136,6 +137,9 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     fdm["simulation/models/FGFCS/enabled"] = 0
     if turbulence is not None:
         start_turbulence(fdm, turbulence, turbulence_seed)
+    delays = [e for e in aircraft.hidden if e.effect == "control_delay"]
+    if delays and loop.kind == "closed":
+        raise ValueError("a hidden control delay is flown open loop only")
 
     t_frames = np.arange(n_frames + 1) * dt
     commands = {s: np.asarray(v, dtype=float) for s, v in deflections(t_frames).items()}
@@ -160,6 +164,14 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         setter(float(values[0]))
         for f in (np.flatnonzero(np.diff(values)) + 1).tolist():
             changes.setdefault(f, []).append((setter, float(values[f])))
+    for e in delays:
+        # the aerodynamics see the surface late: drive its delay property with δ(t − τ) − δ(t)
+        values = trim_pos[e.surface] + commands.get(e.surface, np.zeros(n_frames + 1))
+        delta = delay_deltas(values, frames_of(e.size, dt))
+        setter = node(delay_property(e.surface)).set_double_value
+        setter(float(delta[0]))
+        for f in (np.flatnonzero(np.diff(delta)) + 1).tolist():
+            changes.setdefault(f, []).append((setter, float(delta[f])))
 
     read_props = ([p for _, p in _STATE_CHANNELS] + [props["de"], props["da"], props["dr"]]
                   + list(_FORCES) + list(_AERO) + ["aero/alphadot-rad_sec"])
@@ -213,6 +225,9 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         channels[col] = out[:, j + i]
     for i, col in enumerate(("ax_g", "ay_g", "az_g")):
         channels[col] = out[:, j + 3 + i] / (mass * G0_FPS2)
+    for e in aircraft.hidden:
+        if e.effect == "sensor_offset":
+            offset_accelerometer(channels, e.position_ft)
     qS = channels["qbar_psf"] * trim_point.S_ft2
     X, Y, Z, L, M, N = (out[:, j + 6 + i] for i in range(6))
     alpha = channels["alpha_rad"]
