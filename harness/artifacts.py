@@ -20,7 +20,7 @@ from estimators.state_space import lateral_matrices, short_period_dimensional, s
 from harness.campaign import Campaign, Task
 from harness.noise import apply_noise
 from harness.store import write_parquet
-from harness.tasks import _regression, cached_flight, excited_equations
+from harness.tasks import regression_with_noise, cached_flight, excited_equations
 from maneuvers.recording import Recording
 
 DEG = 180.0 / np.pi
@@ -88,7 +88,7 @@ def example_table(task: Task, cache_dir: str) -> pd.DataFrame:
     frames = []
     for eq in excited_equations(clean, task.equations):
         try:
-            d = _regression(clean, noisy, eq, task.noise.apply_to, task, model)
+            d = regression_with_noise(clean, noisy, eq, task.noise.apply_to, task, model)
             fit = make_estimator("ee-time").fit(d)
         except ValueError:
             continue

@@ -95,7 +95,7 @@ def _truth(rec: Recording, name: str) -> tuple[float, float]:
     return (float("nan"), float("nan")) if d is None else (float(d["local"]), float(d["fit"]))
 
 
-def _regression(clean: Recording, noisy: Recording, eq: Equation, apply_to: str, task: Task,
+def regression_with_noise(clean: Recording, noisy: Recording, eq: Equation, apply_to: str, task: Task,
                 noise_model) -> RegressionData:
     """z and X with regressor and output noise set apart as the noise definition says."""
     opts = DataOptions()
@@ -187,7 +187,7 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
                         fit, elapsed = oe_fits[model]
                     else:
                         if eq not in prepared:
-                            prepared[eq] = _regression(clean, noisy, eq, task.noise.apply_to, task, noise_model)
+                            prepared[eq] = regression_with_noise(clean, noisy, eq, task.noise.apply_to, task, noise_model)
                         d = prepared[eq]
                         est = _estimator(task, method, errors)
                         t0 = time.perf_counter()
@@ -289,7 +289,7 @@ def run_combined_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
         datasets = []
         for clean, noisy, (model, seed) in zip(cleans, noisies, models):
             sub = Task(task.campaign, f0, task.noise, task.realization, seed, (), (), ())
-            datasets.append(_regression(clean, noisy, eq, task.noise.apply_to, sub, model))
+            datasets.append(regression_with_noise(clean, noisy, eq, task.noise.apply_to, sub, model))
         fits = {}
         for method in task.methods:
             errs = task.errors if method == "ee-concat" else ("conventional",)

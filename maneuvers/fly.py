@@ -5,7 +5,6 @@ import math
 from dataclasses import dataclass, field
 
 import jsbsim
-import numpy as np
 import pandas as pd
 
 from maneuvers.base import InputSignal

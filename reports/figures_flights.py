@@ -179,7 +179,7 @@ def fig_input_spectra(flights: pd.DataFrame | None, modes: pd.DataFrame | None =
         ax.set_ylabel(f"{dict(SURFACES)[c]}\n(dB re peak)", fontsize=FONT)
         style_axes(ax)
     axes[-1].set_xlabel("frequency (Hz)", fontsize=FONT)
-    handles, labels = {}, {}
+    handles = {}
     for ax in axes:
         for h, lab in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lab, h)

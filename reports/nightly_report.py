@@ -46,7 +46,7 @@ def nightly_report(out: CampaignOutput, gates: pd.DataFrame, history: list, prev
     if len(failed):
         tables.append(Table("Failures", failed[["gate", "message"]].reset_index(drop=True),
                             "Each names the method, noise, maneuver and parameter that broke the claim."))
-    tables.append(Table("All gated cells", full, "Failures first."))
+    tables.append(Table("All gated cells", full, "Failures first.", hl))
     sections = [
         Section("Gates", ("Each gate states a claim the methods meet, with limits that allow for Monte Carlo "
                           "uncertainty (see harness/nightly-gates.toml).",), tuple(tables)),

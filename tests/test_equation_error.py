@@ -9,7 +9,7 @@ import pytest
 from estimators.equation_error import EquationErrorFrequency, EquationErrorTime, detrend
 from estimators.least_squares import SingularRegressorsError, least_squares
 from estimators.methods import make_estimator, parse_frequencies
-from estimators.regressors import Equation, RegressionData
+from estimators.regressors import RegressionData
 from harness.cli import main
 
 

@@ -5,12 +5,10 @@ Skipped when Chromium is not installed, except under CI=true, where it must run 
 installs it)."""
 from __future__ import annotations
 
-import io
 import os
 import struct
 import subprocess
 import sys
-from dataclasses import dataclass
 from html.parser import HTMLParser
 from pathlib import Path
 
