@@ -27,7 +27,7 @@ import numpy.typing as npt
 from scipy import fft as sp_fft
 from scipy import ndimage, stats
 
-__all__ = ["FourierSmoothing", "optimal_fourier_smoother"]
+__all__ = ["FourierSmoothing", "optimal_fourier_smoother", "sine_series_filter", "sine_series_derivative"]
 
 _MIN_SAMPLES = 8
 _CHI2_1_MEDIAN = float(stats.chi2.median(1))  # median of chi-square(1) ~ 0.4549
@@ -346,3 +346,36 @@ def sine_series_filter(x: npt.ArrayLike, weights: npt.ArrayLike) -> np.ndarray:
     out = line.copy()
     out[1:-1] += 0.5 * sp_fft.dst(w * b, type=1)
     return out
+
+
+def sine_series_derivative(x: npt.ArrayLike, weights: npt.ArrayLike, dt: float) -> np.ndarray:
+    """Time derivative of :func:`sine_series_filter` ``(x, weights)``, term by term.
+
+    ``d/dt [line + sum_k Phi_k b_k sin(k pi t/T)] = s + sum_k Phi_k b_k (k pi/T) cos(k pi t/T)``
+    (seed §III.A, method 2), the same operation as :meth:`FourierSmoothing.derivative` with
+    weights given by the caller, so every record of a set is filtered *and* differentiated by
+    one linear operator.
+
+    Parameters
+    ----------
+    x : array_like, shape (N,) or (N, k)
+        Uniformly sampled real record(s), ``N >= 8``.
+    weights : array_like, shape (N - 2,)
+        One weight per sine coefficient.
+    dt : float
+        Sampling interval, s.
+    """
+    a = np.asarray(x, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    if a.ndim == 2:
+        return np.column_stack([sine_series_derivative(a[:, j], w, dt) for j in range(a.shape[1])])
+    a, dt = _validate(a, dt)
+    n = a.size
+    if w.shape != (n - 2,):
+        raise ValueError(f"weights must have N - 2 = {n - 2} entries, got {w.shape}")
+    span = (n - 1) * dt
+    _, b = _sine_coefficients(a)
+    k = np.arange(1, n - 1)
+    amp = np.zeros(n)
+    amp[1:-1] = w * b * (k * np.pi / span)
+    return (a[-1] - a[0]) / span + 0.5 * sp_fft.dct(amp, type=1)

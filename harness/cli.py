@@ -111,6 +111,26 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     d.set_defaults(func="reports.commands:cmd_demo")
 
+    g = sub.add_parser("diagnose", help="locate and name what a model leaves out of a recording, model it, "
+                                        "show the fit improve",
+                       description="Compare a model with a recording (canonical format): replay the recorded "
+                                   "surfaces from trim, locate the mismatch, test every effect of effects.md, add "
+                                   "the significant ones to the model and fly it again. Writes OUT/findings.json, "
+                                   "OUT/report.html, OUT/series/*.parquet and OUT/model/ (the augmented aircraft).")
+    g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6)")
+    g.add_argument("--recording", required=True, help="identification recording (.csv beside .meta.json, or .parquet)")
+    g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
+    g.add_argument("--out", required=True, help="output folder")
+    g.set_defaults(func="reports.commands:cmd_diagnose")
+
+    gg = sub.add_parser("gallery", help="write the concealed-effect recordings (identification + validation)",
+                        description="Fly the F-16 with one hidden effect per case, add the realistic noise layer "
+                                    "and write OUT/<case>-identification.csv, -validation.csv and the answer.")
+    gg.add_argument("--out", default="out/gallery", help="output folder")
+    gg.add_argument("--seed", type=int, default=1, help="noise seed of the identification maneuver (validation: +1)")
+    gg.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
+    gg.set_defaults(func="harness.diagnosis.commands:cmd_gallery")
+
     r = sub.add_parser("report", help="turn campaign output into HTML, Markdown and JSON reports",
                        description="Write report.html (self-contained), report.md and report.json for a campaign "
                                    "output folder; --kind benchmark ranks the methods over one or more folders.")

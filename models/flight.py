@@ -10,7 +10,7 @@ import numpy as np
 
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence, start_turbulence
-from models.hidden import delay_deltas, delay_property, frames_of, offset_accelerometer
+from models.hidden import apply_sensor_effects, delay_deltas, delay_property, frames_of
 from models.trim import G0_FPS2, TrimPoint
 
 Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
@@ -225,9 +225,7 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         channels[col] = out[:, j + i]
     for i, col in enumerate(("ax_g", "ay_g", "az_g")):
         channels[col] = out[:, j + 3 + i] / (mass * G0_FPS2)
-    for e in aircraft.hidden:
-        if e.effect == "sensor_offset":
-            offset_accelerometer(channels, e.position_ft)
+    apply_sensor_effects(channels, tuple(aircraft.hidden), 1.0 / sample_rate_hz)
     qS = channels["qbar_psf"] * trim_point.S_ft2
     X, Y, Z, L, M, N = (out[:, j + 6 + i] for i in range(6))
     alpha = channels["alpha_rad"]

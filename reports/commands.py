@@ -72,6 +72,24 @@ def cmd_review_maneuvers(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_diagnose(args: argparse.Namespace) -> int:
+    """Run the discrepancy diagnosis and write its report."""
+    from harness.diagnosis.run import diagnose
+    from reports.diagnosis_report import write_diagnosis_report
+    result = diagnose(args.model, args.recording, args.out, args.validation)
+    html = write_diagnosis_report(Path(args.out))
+    for f in result["findings"]:
+        if f["effect"] == "none":
+            print(f"none: {f['explanation']}")
+        else:
+            print(f"{f['effect']}: {f['parameter']} = {f['estimate']:.4g} ± {f['std_error']:.2g} {f['units']}"
+                  f"  (t = {f['evidence']['t']:.1f})")
+            print(f"    {f['explanation']}")
+    print(f"{result['located']['summary']}")
+    print(f"diagnosis took {result['timing_s']['total']:.1f} s; wrote {Path(args.out) / 'findings.json'} and {html}")
+    return 0
+
+
 def cmd_demo(args: argparse.Namespace) -> int:
     """Fly the default maneuver and print its truth, then run a quick campaign and report it."""
     from harness.campaign import load_campaign

@@ -26,6 +26,7 @@ _KIND_LABELS = {
     "nightly": "Nightly report",
     "benchmark": "Benchmark report",
     "maneuver-review": "Maneuver review",
+    "diagnosis": "Discrepancy diagnosis",
 }
 
 _CSS = """

@@ -34,7 +34,7 @@ __all__ = [
     "jsonable", "png_size", "provenance_items", "iter_tables",
 ]
 
-KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review")
+KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis")
 """The kinds of report the project writes."""
 STATUSES: tuple[str, ...] = ("ok", "fail")
 """Report outcomes (the nightly gate's verdict; ``ok`` for reports without a gate)."""

@@ -1,0 +1,204 @@
+"""One recording set against the model: the replay, the coefficient mismatch, and every
+candidate test, gathered into scored candidates."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, corrected_channels, is_practical,
+                                          kinematic_check, kinematic_residuals)
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
+from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
+from models.aircraft import Aircraft
+from models.replay import AeroAlong, InitialCondition, aero_along
+
+SENSOR_UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s",
+                "phi": "rad", "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
+
+
+@dataclass
+class Candidate:
+    """A candidate effect with its test statistic (a row of the report's candidate table)."""
+
+    effect: str
+    axis: str | None
+    channel: str | None
+    parameter: str
+    estimate: float
+    std_error: float
+    t: float
+    explained_fraction: float
+    units: str
+    test: str
+    selected: bool = False
+    reason: str = ""
+    details: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        d = {k: getattr(self, k) for k in ("effect", "axis", "channel", "parameter", "estimate", "std_error", "t",
+                                            "explained_fraction", "units", "selected", "reason")}
+        d["test"] = self.test
+        return {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in d.items()}
+
+
+@dataclass
+class Analysis:
+    prepared: Prepared
+    ic: InitialCondition
+    aero: AeroAlong
+    mismatch: dict[str, np.ndarray]
+    noise: dict[str, float]          # per axis: the mismatch's noise level (high-frequency part)
+    candidates: list[Candidate]
+    selections: dict
+    kinematic: KinematicResult
+    delay: dict
+    offset: cand.OffsetTest
+    gust: object
+    peak: object
+
+
+def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
+    """A noise level per axis: the RMS of the mismatch about a 1 s running mean (the part no
+    slow deterministic effect explains), floored to stay positive."""
+    k = max(3, int(round(1.0 / p.dt)))
+    kernel = np.ones(k) / k
+    out = {}
+    for c, r in mismatch.items():
+        hp = r - np.convolve(r, kernel, mode="same")
+        out[c] = max(float(np.std(hp[k:-k])), 1e-9 * max(float(np.std(r)), 1e-12))
+    return out
+
+
+def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
+    """Run every test on recording ``p`` against ``aircraft`` (module docstring)."""
+    # 1. sensors first: kinematic consistency says what the instruments did
+    kin = kinematic_check(p)
+    sensor_values = {n: kin.selection.params[n] for n in kin.selection.names}
+    cands: list[Candidate] = []
+    for term in kin.selection.terms:
+        sp = kin.parameters[term.name]
+        practical = is_practical(term.name, term.estimate, p.dt)
+        precise = term.std_error <= max(0.5 * _practical_size(term.name, p.dt), 0.25 * abs(term.estimate))
+        sel = term.selected and practical and precise
+        reason = ("significant, practical and precise" if sel else
+                  "below the entry t" if not term.selected else
+                  "within the instrument noise budget (practical size)" if not practical else "poorly determined")
+        cands.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
+                               sp.units, "kinematic consistency", sel, reason))
+    # correct the channels for everything the kinematics found (noise-budget biases too)
+    if sensor_values:
+        ch = corrected_channels(p.raw, p, kin.parameters, sensor_values)
+        smooth = {c: p.filt(x) for c, x in ch.items()}
+        deriv = {c: p.differentiate(x) for c, x in ch.items()}
+        k = max(1, int(round(0.5 / p.dt)))
+        start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
+        p = replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
+    # 2. the model along the measured states
+    states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
+    if "h" in p.smooth:
+        states["h"] = p.smooth["h"]
+    aero = aero_along(aircraft, ic, states, {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth},
+                      p.deriv["alpha"])
+    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.start, aero.trim.thrust_lbf)
+    mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
+    noise = coefficient_noise(p, mismatch)
+    # 3. accelerometer position from the force mismatches
+    off = cand.accelerometer_offset(p, mismatch, noise)
+    x, sx = off.position_ft[0], off.std_error_ft[0]
+    t_best = max(abs(v) for v in off.t)
+    off_sel = t_best >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"] and off.gain >= cand.MIN_GAIN / 2
+    cands.append(Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
+                           x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", off_sel,
+                           "significant and practical" if off_sel else "not significant or under 1.5 ft",
+                           {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
+                            "t_xyz": list(off.t)}))
+    if off_sel:
+        cols = cand.accelerometer_columns(p)
+        for i, a in enumerate("xyz"):
+            for c in ("CX", "CY", "CZ"):
+                mismatch[c] = mismatch[c] - off.position_ft[i] * cols[a][c]
+    # 4. delay scans
+    delays = {}
+    for s in ("de", "da", "dr"):
+        scan = cand.delay_scan(p, s, mismatch, aero.derivatives, noise)
+        if scan is not None:
+            delays[s] = scan
+    # 5. per-axis stepwise
+    selections = {}
+    for axis in COEFFICIENTS:
+        terms = cand.library(p, axis, aero.derivatives, measured)
+        extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
+        sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra)
+        selections[axis] = (sel, {t.key: t for t in terms})
+    cands += _aero_candidates(selections, delays)
+    # 6. spectra and gusts
+    peak = structural_peak(p)
+    if peak is not None:
+        sel = peak.p_value < FISHER_P
+        cands.append(Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
+                               peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), peak.g, "Hz",
+                               "residual-spectrum peak over its local median", sel,
+                               f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else ""),
+                               {"amplitude": peak.amplitude}))
+    e = kinematic_residuals(p.raw, p)
+    gust = gust_estimate(e, p, 0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * 32.174)
+    gsel = gust.ratio_to_noise >= 4.0 and max(gust.sigma_w_fps, gust.sigma_v_fps) >= 3.0
+    cands.append(Candidate("turbulence", None, None, "sigma_gust_fps", max(gust.sigma_w_fps, gust.sigma_v_fps),
+                           max(gust.sigma_w_fps, gust.sigma_v_fps) / 4.0, gust.ratio_to_noise, 0.0, "ft/s",
+                           "air-relative vs inertial velocity (integrated kinematic residual)", gsel,
+                           f"gust/noise ratio {gust.ratio_to_noise:.1f}",
+                           {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}))
+    return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
+                    selections=selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak)
+
+
+def _practical_size(name: str, dt: float) -> float:
+    kind, _, channel = name.partition("_")
+    if kind == "bias":
+        return PRACTICAL["bias"].get(channel, 1.0)
+    if kind == "scale":
+        return PRACTICAL["scale"]
+    if kind == "skew":
+        return PRACTICAL["skew_samples"] * dt
+    return PRACTICAL["offset_ft"]
+
+
+def _aero_candidates(selections: dict, delays: dict) -> list[Candidate]:
+    out: list[Candidate] = []
+    delay_seen: dict[str, list] = {}
+    cg_seen: list = []
+    for axis, (sel, terms) in selections.items():
+        for t in sel.terms:
+            if t.name.startswith("delay_"):
+                delay_seen.setdefault(t.name[6:], []).append((axis, t))
+                continue
+            term = terms[t.name]
+            if term.effect == "cg_offset":
+                cg_seen.append((axis, t, term))
+                continue
+            est, se = t.estimate * term.scale, abs(t.std_error * term.scale)
+            if term.effect == "coefficient_error":
+                est = term.details["model_value"] + t.estimate
+            out.append(Candidate(term.effect, cand.AXIS_NAME[axis], axis, term.parameter, est, se, t.t, t.gain,
+                                 term.units, f"stepwise on the {axis} mismatch", t.selected,
+                                 "entered" if t.selected else "not entered",
+                                 {"change": t.estimate} if term.effect == "coefficient_error" else {}))
+    for s, rows in delay_seen.items():
+        scan = delays[s]
+        # significance from the stepwise entry of the delay column (its coefficient is τ);
+        # size and standard error from the scan's linearised fit
+        best = max(rows, key=lambda r: abs(r[1].t))[1]
+        sel = any(t.selected for _, t in rows) and scan.tau_s > 0
+        gain = max(t.gain for _, t in rows)
+        out.append(Candidate("control_delay", "pitch" if s == "de" else ("roll" if s == "da" else "yaw"), s, f"tau_{s}",
+                             scan.tau_s, scan.std_error, best.t, gain, "s", f"delay scan of {s} + stepwise", sel,
+                             "entered" if sel else "not entered",
+                             {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
+    if cg_seen:
+        axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))
+        out.append(Candidate("cg_offset", cand.AXIS_NAME[axis], axis, term.parameter, t.estimate * term.scale,
+                             abs(t.std_error * term.scale), t.t, t.gain, "ft", f"stepwise on the {axis} mismatch",
+                             any(r[1].selected for r in cg_seen), "entered" if t.selected else "not entered"))
+    return out

@@ -1,0 +1,207 @@
+"""Aerodynamic and actuator effects: the coefficient mismatch regressed on a library of
+physically named candidate terms, a delay scan per surface, and the accelerometer position.
+
+The coefficient mismatch of axis C is ``ΔC = C_measured − C_model(measured states)``. Each
+candidate column is named by the effect of ``../shared/effects.md`` it stands for; the
+columns enter by :func:`estimators.colored_stepwise.colored_forward_selection`, so a term is
+named only when its colored-residual t statistic clears ``T_IN`` and it removes a real share
+of the mismatch.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
+from harness.diagnosis.prepare import Prepared
+
+T_IN = 5.0
+MIN_GAIN = 0.05
+LON = ("CX", "CZ", "Cm")
+LAT = ("CY", "Cl", "Cn")
+AXIS_NAME = {"CX": "lon", "CZ": "lon", "Cm": "pitch", "CY": "lat", "Cl": "roll", "Cn": "yaw"}
+SURFACE_AXES = {"de": LON, "da": LAT, "dr": LAT}
+DELAY_GRID_S = np.arange(0.0, 0.3001, 0.002)
+G0 = 32.17404855643
+
+
+@dataclass(frozen=True)
+class Term:
+    """One candidate column: which effect it stands for and how its coefficient becomes the
+    effect's size (``size = scale · coefficient``)."""
+
+    key: str          # unique within an axis, e.g. 'alphadot'
+    effect: str
+    parameter: str
+    units: str
+    column: np.ndarray
+    scale: float = 1.0
+    details: dict = field(default_factory=dict)
+
+
+def _hat(p: Prepared, rate: str, length: float) -> np.ndarray:
+    return p.smooth[rate] * length / (2.0 * p.smooth["V"])
+
+
+def regressors(p: Prepared) -> dict[str, np.ndarray]:
+    """Perturbations from the recording's start (rates normalised), the model's own terms."""
+    geo = p.meta["geometry"]
+    s, st = p.smooth, p.start
+    out = {"alpha": s["alpha"] - st["alpha"], "qhat": _hat(p, "q", geo["cbar_ft"]),
+           "beta": s["beta"] - st["beta"], "phat": _hat(p, "p", geo["b_ft"]), "rhat": _hat(p, "r", geo["b_ft"])}
+    for sfc in ("de", "da", "dr"):
+        if sfc in s:
+            out[sfc] = s[sfc] - st[sfc]
+    return out
+
+
+def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dict[str, np.ndarray]) -> list[Term]:
+    """The candidate terms for the mismatch of coefficient ``axis``."""
+    geo = p.meta["geometry"]
+    reg = regressors(p)
+    a = reg["alpha"]
+    units_rate = "per rad (rates normalised by c/2V or b/2V)"
+    own = ("alpha", "qhat", "de") if axis in LON else ("beta", "phat", "rhat", "da", "dr")
+    terms = []
+    for r in own:
+        if r in reg:
+            terms.append(Term(r, "coefficient_error", f"{axis}_{r}", units_rate, reg[r],
+                              details={"model_value": derivatives.get(f"{axis}_{r}", float("nan"))}))
+    if axis in LON:
+        adot = p.deriv["alpha"] * geo["cbar_ft"] / (2.0 * p.smooth["V"])
+        terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)", adot))
+        terms.append(Term("alpha2", "nonlinear_alpha", f"{axis}_alpha2", "per rad^2", a ** 2))
+        terms.append(Term("alpha3", "nonlinear_alpha", f"{axis}_alpha3", "per rad^3", a ** 3))
+    else:
+        terms.append(Term("alpha_beta", "cross_coupling", f"{axis}_alpha_beta", "per rad^2", a * reg["beta"]))
+    V0 = p.start["V"]
+    terms.append(Term("dV", "flight_condition_drift", f"{axis}_dV", "per unit dV/V", (p.smooth["V"] - V0) / V0))
+    if axis == "Cm":
+        terms.append(Term("cg", "cg_offset", "dx_moment_reference", "ft", measured["CZ"], scale=geo["cbar_ft"]))
+    if axis == "Cn":
+        terms.append(Term("cg", "cg_offset", "dx_moment_reference", "ft", measured["CY"], scale=-geo["b_ft"]))
+    return terms
+
+
+@dataclass(frozen=True)
+class DelayScan:
+    surface: str
+    tau_s: float
+    std_error: float
+    t: float
+    sse: np.ndarray      # normalised SSE over DELAY_GRID_S
+    columns: dict[str, np.ndarray]  # per axis: ΔC(τ̂)/τ̂ (coefficient of the column is τ)
+
+
+def _shift(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
+    t = np.arange(x.size) * dt
+    return np.interp(t - tau, t, x)
+
+
+def delay_scan(p: Prepared, surface: str, mismatch: dict[str, np.ndarray], derivatives: dict[str, float],
+               noise: dict[str, float]) -> DelayScan | None:
+    """Scan a transport delay τ of ``surface``: the model then sees δ(t − τ), so its
+    coefficients change by C_δ·(δ(t − τ) − δ(t)); τ̂ minimises the noise-weighted mismatch
+    over the axes the surface drives. Its standard error is the colored-residual one of
+    the linearised column −C_δ δ̇(t − τ̂)."""
+    if surface not in p.smooth or surface not in p.excited:
+        return None
+    axes = [c for c in SURFACE_AXES[surface] if abs(derivatives.get(f"{c}_{surface}", 0.0)) > 0]
+    if not axes:
+        return None
+    x = p.smooth[surface]
+    k = max(1, int(round(1.0 / p.dt)))
+    inner = slice(k, p.n - k)
+    sse = []
+    for tau in DELAY_GRID_S:
+        dx = _shift(x, tau, p.dt) - x
+        total = 0.0
+        for c in axes:
+            r = mismatch[c][inner] - derivatives[f"{c}_{surface}"] * dx[inner]
+            total += float(np.sum((r - r.mean()) ** 2)) / noise[c] ** 2
+        sse.append(total)
+    sse = np.asarray(sse)
+    j = int(np.argmin(sse))
+    tau = float(DELAY_GRID_S[j])
+    xd = p.differentiate(_shift(x, tau, p.dt))
+    # stacked linearised fit for the standard error
+    z, col, intercepts = [], [], []
+    for i, c in enumerate(axes):
+        w = 1.0 / noise[c]
+        dx = _shift(x, tau, p.dt) - x
+        z.append((mismatch[c][inner] - derivatives[f"{c}_{surface}"] * dx[inner]) * w)
+        col.append(-derivatives[f"{c}_{surface}"] * xd[inner] * w)
+        ind = np.zeros(len(axes))
+        ind[i] = 1.0
+        intercepts.append(np.tile(ind, (inner.stop - inner.start, 1)))
+    Z, G, I = np.concatenate(z), np.concatenate(col), np.vstack(intercepts)
+    theta, se, _ = colored_fit(Z, [G] + [I[:, i] for i in range(len(axes))], ["dtau"] + [f"b{i}" for i in range(len(axes))],
+                               constant=False)
+    tau_hat = tau + float(theta[0]) if tau > 0 else float(theta[0])
+    std = float(se[0])
+    columns = {}
+    for c in axes:
+        if tau_hat > 1e-4:
+            columns[c] = derivatives[f"{c}_{surface}"] * (_shift(x, tau_hat, p.dt) - x) / tau_hat
+        else:
+            columns[c] = -derivatives[f"{c}_{surface}"] * p.deriv[surface]
+    return DelayScan(surface, tau_hat, std, tau_hat / std if std > 0 else 0.0, sse, columns)
+
+
+def accelerometer_columns(p: Prepared) -> dict[str, dict[str, np.ndarray]]:
+    """ΔCX, ΔCY, ΔCZ per ft of accelerometer x, y, z position (the coefficient error a
+    sensor at r makes: m[ω̇ × r + ω × (ω × r)]/(q̄S))."""
+    s, d = p.smooth, p.deriv
+    m, S = p.meta["mass"]["mass_slug"], p.meta["geometry"]["S_ft2"]
+    w = np.stack([s["p"], s["q"], s["r"]], axis=-1)
+    wd = np.stack([d["p"], d["q"], d["r"]], axis=-1)
+    out = {}
+    for i, a in enumerate("xyz"):
+        r = np.zeros(3)
+        r[i] = 1.0
+        extra = (np.cross(wd, r) + np.cross(w, np.cross(w, r))) * m / (s["qbar"] * S)[:, None]
+        out[a] = {"CX": extra[:, 0], "CY": extra[:, 1], "CZ": extra[:, 2]}
+    return out
+
+
+@dataclass(frozen=True)
+class OffsetTest:
+    position_ft: tuple[float, float, float]
+    std_error_ft: tuple[float, float, float]
+    t: tuple[float, float, float]
+    gain: float
+
+
+def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]) -> OffsetTest:
+    """Least squares of the stacked, noise-weighted force mismatches on the accelerometer
+    position (with an intercept per axis), colored-residual standard errors."""
+    cols = accelerometer_columns(p)
+    k = max(1, int(round(1.0 / p.dt)))
+    inner = slice(k, p.n - k)
+    axes = ("CX", "CY", "CZ")
+    m = inner.stop - inner.start
+    Z = np.concatenate([mismatch[c][inner] / noise[c] for c in axes])
+    X = [np.concatenate([cols[a][c][inner] / noise[c] for c in axes]) for a in "xyz"]
+    I = [np.concatenate([np.full(m, 1.0 if c == ci else 0.0) for c in axes]) for ci in axes]
+    keep = [i for i in range(3) if np.ptp(X[i]) > 1e-12]
+    theta, se, resid = colored_fit(Z, [X[i] for i in keep] + I, [f"r{i}" for i in keep] + list(axes), constant=False)
+    _, _, r0 = colored_fit(Z, I, list(axes), constant=False)
+    pos, ses = [0.0, 0.0, 0.0], [np.inf, np.inf, np.inf]
+    for j, i in enumerate(keep):
+        pos[i], ses[i] = float(theta[j]), float(se[j])
+    gain = 1.0 - float(resid @ resid) / float(r0 @ r0)
+    return OffsetTest(tuple(pos), tuple(ses), tuple(pos[i] / ses[i] if np.isfinite(ses[i]) and ses[i] > 0 else 0.0
+                                                 for i in range(3)), gain)
+
+
+def axis_selection(p: Prepared, axis: str, mismatch: np.ndarray, terms: list[Term],
+                   extra: dict[str, np.ndarray] | None = None) -> ColoredSelection:
+    """Forward selection of ``terms`` (plus ``extra`` columns, e.g. a delay) on the interior
+    of one axis's mismatch."""
+    k = max(1, int(round(1.0 / p.dt)))
+    inner = slice(k, p.n - k)
+    cands = {t.key: t.column[inner] for t in terms}
+    for key, col in (extra or {}).items():
+        cands[key] = col[inner]
+    return colored_forward_selection(mismatch[inner], cands, t_in=T_IN, min_gain=MIN_GAIN, max_terms=3)

@@ -1,0 +1,14 @@
+"""The ``sidbench gallery`` subcommand."""
+from __future__ import annotations
+
+import argparse
+
+from harness.diagnosis.gallery import CASES, case, write_case
+
+
+def cmd_gallery(args: argparse.Namespace) -> int:
+    names = args.case or [c.name for c in CASES]
+    for name in names:
+        paths = write_case(case(name), args.out, args.seed)
+        print(f"{name}: {paths['identification']} and {paths['validation']}")
+    return 0

@@ -1,0 +1,181 @@
+"""Sensor effects by kinematic consistency (data compatibility) in equation-error form.
+
+The rigid-body kinematics tie the recorded channels together whatever the aerodynamics:
+
+    u̇ = rv − qw − g sinθ + g a_x            φ̇ = p + tanθ (q sinφ + r cosφ)
+    v̇ = pw − ru + g cosθ sinφ + g a_y       θ̇ = q cosφ − r sinφ
+    ẇ = qu − pv + g cosθ cosφ + g a_z       ḣ = u sinθ − v sinφ cosθ − w cosφ cosθ
+
+with u, v, w from V, α, β. Each equation's residual E (left minus right, both through the
+recording's common filter) is zero for perfect sensors. A sensor effect with parameter θ —
+a bias, a scale factor, a time skew, an accelerometer or vane away from the c.g. — makes
+E ≈ −J θ, J the change of E when the recorded channel is corrected by θ (central
+differences). The candidates are then selected by colored t statistics on the stacked,
+noise-weighted residuals (:func:`estimators.colored_stepwise.colored_forward_selection`).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from estimators.colored_stepwise import ColoredSelection, colored_forward_selection
+from harness.diagnosis.prepare import Prepared
+
+G0 = 32.17404855643
+EARTH_RADIUS_FT = 20_925_646.3
+BIAS_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "phi", "theta", "ax", "ay", "az")
+SCALE_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "ax", "ay", "az")
+SKEW_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "phi", "theta", "ax", "ay", "az")
+# Smallest size worth naming: three times the ``realistic`` preset's own biases (which the
+# null recordings carry), 2 % scale, two samples of skew, 1.5 ft of offset.
+DEG = np.pi / 180
+PRACTICAL = {"bias": {"alpha": 0.3 * DEG, "beta": 0.15 * DEG, "V": 3.0, "p": 0.15 * DEG, "q": 0.15 * DEG,
+                      "r": 0.15 * DEG, "phi": 1.0 * DEG, "theta": 1.0 * DEG, "ax": 0.015, "ay": 0.015, "az": 0.015},
+             "scale": 0.02, "skew_samples": 2.0, "offset_ft": 1.5}
+UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s", "phi": "rad",
+         "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
+
+
+@dataclass(frozen=True)
+class SensorParameter:
+    """One candidate sensor parameter: its correction of the raw channels and FD step."""
+
+    name: str           # bias_alpha, scale_q, skew_az, offset_x, vane_alpha_x ...
+    effect: str         # effects.md id
+    channel: str
+    units: str
+    step: float
+    correct: Callable[[dict, Prepared, float], dict]
+
+
+def _with(ch: dict, name: str, x: np.ndarray) -> dict:
+    out = dict(ch)
+    out[name] = x
+    return out
+
+
+def _bias(c: str) -> Callable:
+    return lambda ch, p, th: _with(ch, c, ch[c] - th)
+
+
+def _scale(c: str) -> Callable:
+    return lambda ch, p, th: _with(ch, c, ch[c] / (1.0 + th))
+
+
+def _skew(c: str) -> Callable:
+    # the channel lags by τ: x_true(t) = x_meas(t + τ) ≈ x_meas + τ ẋ
+    return lambda ch, p, th: _with(ch, c, ch[c] + th * p.differentiate(ch[c]))
+
+
+def _accel_offset(axis: int) -> Callable:
+    def correct(ch: dict, p: Prepared, th: float) -> dict:
+        r = np.zeros(3)
+        r[axis] = th
+        w = np.stack([ch["p"], ch["q"], ch["r"]], axis=-1)
+        wd = np.stack([p.differentiate(ch["p"]), p.differentiate(ch["q"]), p.differentiate(ch["r"])], axis=-1)
+        extra = (np.cross(wd, r) + np.cross(w, np.cross(w, r))) / G0
+        out = dict(ch)
+        for i, c in enumerate(("ax", "ay", "az")):
+            out[c] = ch[c] - extra[:, i]
+        return out
+    return correct
+
+
+def _vane(c: str) -> Callable:
+    # a vane x ft ahead of the c.g.: α_v = α − x q/V, β_v = β + x r/V
+    if c == "alpha":
+        return lambda ch, p, th: _with(ch, "alpha", ch["alpha"] + th * ch["q"] / ch["V"])
+    return lambda ch, p, th: _with(ch, "beta", ch["beta"] - th * ch["r"] / ch["V"])
+
+
+def sensor_parameters(p: Prepared) -> tuple[SensorParameter, ...]:
+    """Every candidate sensor parameter for the channels this recording has."""
+    have = set(p.raw)
+    out = [SensorParameter(f"bias_{c}", "sensor_bias", c, UNITS[c], 1e-4 if c != "V" else 0.1, _bias(c))
+           for c in BIAS_CHANNELS if c in have]
+    out += [SensorParameter(f"scale_{c}", "sensor_scale", c, "1", 1e-3, _scale(c)) for c in SCALE_CHANNELS if c in have]
+    out += [SensorParameter(f"skew_{c}", "sensor_time_skew", c, "s", p.dt / 4, _skew(c))
+            for c in SKEW_CHANNELS if c in have]
+    out += [SensorParameter(f"offset_{a}", "sensor_offset", "accelerometer", "ft", 0.1, _accel_offset(i))
+            for i, a in enumerate("xyz")]
+    out += [SensorParameter(f"vane_{c}_x", "sensor_offset", c, "ft", 0.1, _vane(c)) for c in ("alpha", "beta")]
+    return tuple(out)
+
+
+def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndarray]:
+    """E per kinematic equation (module docstring) from raw-rate channels ``ch``."""
+    V, a, b = ch["V"], ch["alpha"], ch["beta"]
+    u, v, w = V * np.cos(a) * np.cos(b), V * np.sin(b), V * np.sin(a) * np.cos(b)
+    P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
+    h = ch.get("h")
+    g = G0 * (EARTH_RADIUS_FT / (EARTH_RADIUS_FT + (h if h is not None else 0.0))) ** 2
+    D, F = p.differentiate, p.filt
+    out = {
+        "u": D(u) - F(R * v - Q * w - g * np.sin(th) + G0 * ch["ax"]),
+        "v": D(v) - F(P * w - R * u + g * np.cos(th) * np.sin(phi) + G0 * ch["ay"]),
+        "w": D(w) - F(Q * u - P * v + g * np.cos(th) * np.cos(phi) + G0 * ch["az"]),
+        "phi": D(phi) - F(P + np.tan(th) * (Q * np.sin(phi) + R * np.cos(phi))),
+        "theta": D(th) - F(Q * np.cos(phi) - R * np.sin(phi)),
+    }
+    if h is not None:
+        out["h"] = D(h) - F(u * np.sin(th) - v * np.sin(phi) * np.cos(th) - w * np.cos(phi) * np.cos(th))
+    return out
+
+
+@dataclass(frozen=True)
+class KinematicResult:
+    selection: ColoredSelection
+    parameters: dict[str, SensorParameter]
+    equations: tuple[str, ...]
+    weights: dict[str, float]
+    residual_rms: dict[str, float]   # per equation, before (weighted units removed)
+    start: np.ndarray                # stacked weighted residual before corrections
+
+
+def kinematic_check(p: Prepared, *, t_in: float = 6.0, min_gain: float = 0.02, max_terms: int = 8) -> KinematicResult:
+    """Select the sensor parameters the kinematics call for (module docstring).
+
+    The entry t is 6 rather than the aerodynamic 5: the kinematic residuals carry the
+    differentiated airspeed and angle noise, strongly coloured, and on null recordings the
+    airspeed scale and bias reach |t| ≈ 4.6."""
+    ch = dict(p.raw)
+    # The first and last second are where the sine-series filter is least accurate.
+    k = max(1, int(round(1.0 / p.dt)))
+    inner = slice(k, p.n - k)
+    e0 = kinematic_residuals(ch, p)
+    eqs = tuple(e0)
+    weights = {e: 1.0 / max(float(np.std(e0[e][inner] - np.mean(e0[e][inner]))), 1e-12) for e in eqs}
+    stack = np.concatenate([e0[e][inner] * weights[e] for e in eqs])
+    params = {sp.name: sp for sp in sensor_parameters(p)}
+    columns = {}
+    for name, sp in params.items():
+        plus = kinematic_residuals(sp.correct(ch, p, sp.step), p)
+        minus = kinematic_residuals(sp.correct(ch, p, -sp.step), p)
+        # E(0) ≈ −J θ: regress E(0) on −J
+        columns[name] = np.concatenate([-(plus[e][inner] - minus[e][inner]) / (2 * sp.step) * weights[e] for e in eqs])
+    sel = colored_forward_selection(stack, columns, t_in=t_in, min_gain=min_gain, max_terms=max_terms, constant=False)
+    return KinematicResult(selection=sel, parameters=params, equations=eqs, weights=weights,
+                           residual_rms={e: float(np.sqrt(np.mean(e0[e][inner] ** 2))) for e in eqs}, start=stack)
+
+
+def is_practical(name: str, value: float, dt: float) -> bool:
+    """Whether a sensor parameter is large enough to name (:data:`PRACTICAL`)."""
+    kind, _, channel = name.partition("_")
+    if kind == "bias":
+        return abs(value) >= PRACTICAL["bias"].get(channel, 0.0)
+    if kind == "scale":
+        return abs(value) >= PRACTICAL["scale"]
+    if kind == "skew":
+        return abs(value) >= PRACTICAL["skew_samples"] * dt
+    return abs(value) >= PRACTICAL["offset_ft"]
+
+
+def corrected_channels(raw: dict[str, np.ndarray], p: Prepared, params: dict[str, SensorParameter],
+                       values: dict[str, float]) -> dict[str, np.ndarray]:
+    """Raw channels with the estimated sensor parameters undone."""
+    ch = dict(raw)
+    for name, v in values.items():
+        ch = params[name].correct(ch, p, v)
+    return ch

@@ -1,0 +1,326 @@
+"""The whole diagnosis of one recording (and its validation maneuver) against a model, and
+its output folder: findings.json, series/*.parquet, model/ (the augmented JSBSim aircraft)."""
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from harness.atomic import write_atomic, write_text_atomic
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.analysis import Analysis, Candidate, analyse
+from harness.diagnosis.fits import coefficient_fit, output_fit
+from harness.diagnosis.kinematics import corrected_channels
+from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
+from harness.recording_io import read_recording
+from models.aircraft import MODELS, Aircraft
+from models.hidden import HiddenEffect, hidden_root
+from models.replay import initial_condition, replay
+
+SURFACES = ("de", "da", "dr")
+_CHANNEL_COLUMNS = {"alpha": "alpha_rad", "beta": "beta_rad", "p": "p_rps", "q": "q_rps", "r": "r_rps",
+                    "phi": "phi_rad", "theta": "theta_rad", "V": "V_fps", "ax": "ax_g", "ay": "ay_g", "az": "az_g"}
+EXPLAIN = {
+    "unsteady_alphadot": "The {axis} mismatch follows the angle-of-attack rate: the model lacks an unsteady "
+                         "(downwash-lag) term, estimated as {parameter} = {estimate:.3g} ± {std_error:.2g} {units}.",
+    "control_delay": "The model responds to {channel} too early: the surface acts about {estimate:.3f} ± "
+                     "{std_error:.3f} s after the recorded position (an actuator delay the model lacks).",
+    "sensor_offset": "The accelerometer is not at the c.g.: its readings carry the rotational terms of a sensor "
+                     "about {estimate:.2f} ± {std_error:.2f} ft ahead of it (x).",
+    "nonlinear_alpha": "The {axis} mismatch curves with angle of attack: the model lacks a nonlinear term, "
+                       "{parameter} = {estimate:.3g} ± {std_error:.2g} {units}.",
+    "coefficient_error": "The model's {parameter} is off: the data say {estimate:.4g} ± {std_error:.2g} {units}, "
+                         "the model has {model_value:.4g}.",
+    "cross_coupling": "The {axis} mismatch follows (alpha - alpha_trim)·beta: a coupling term {parameter} = "
+                      "{estimate:.3g} ± {std_error:.2g} {units} is missing.",
+    "flight_condition_drift": "The {axis} mismatch trends with the airspeed change: {parameter} = {estimate:.3g} ± "
+                              "{std_error:.2g} per unit dV/V.",
+    "cg_offset": "The moment reference is {estimate:.2f} ± {std_error:.2f} ft away from where the model puts it "
+                 "(the {axis} mismatch follows the force coefficient).",
+    "sensor_bias": "The {channel} sensor reads {estimate:.4g} ± {std_error:.2g} {units} off: the kinematics of the "
+                   "other channels disagree with it by a constant.",
+    "sensor_scale": "The {channel} sensor has a scale-factor error k = {estimate:.3g} ± {std_error:.2g}.",
+    "sensor_time_skew": "The {channel} channel lags the others by {estimate:.3f} ± {std_error:.3f} s.",
+    "structural_mode": "A narrow spectral peak at {estimate:.2f} Hz in {channel} points to an unmodelled flexible "
+                       "mode.",
+    "turbulence": "The air-relative and inertial velocities disagree broadband (gust RMS about {estimate:.1f} ft/s): "
+                  "the flight was in turbulence, which no deterministic model term can replay.",
+}
+
+
+class DiagnosisError(RuntimeError):
+    """The diagnosis cannot run: the message names the input and the cause."""
+
+
+def _aircraft(model: str) -> Aircraft:
+    if model in MODELS:
+        return Aircraft(model)
+    raise DiagnosisError(f"--model {model!r} is not one of the project's models {MODELS}; "
+                         "a JSBSim XML path is not supported yet (see the README's limits)")
+
+
+def _effect_of(c: Candidate) -> HiddenEffect | None:
+    """The model term a finding adds (None for what no deterministic term can add)."""
+    e = c.effect
+    coef = c.channel if c.channel in COEFFICIENTS else "Cm"
+    if e == "unsteady_alphadot":
+        return HiddenEffect(e, c.estimate, coefficient=coef)
+    if e == "nonlinear_alpha":
+        return HiddenEffect(e, c.estimate, coefficient=coef, power=int(c.parameter[-1]))
+    if e == "coefficient_error":
+        return HiddenEffect(e, c.details["change"], coefficient=coef, regressor=c.parameter.split("_", 1)[1])
+    if e in ("cross_coupling", "flight_condition_drift"):
+        return HiddenEffect(e, c.estimate, coefficient=coef)
+    if e == "cg_offset":
+        return HiddenEffect(e, c.estimate)
+    if e == "control_delay":
+        return HiddenEffect(e, max(c.estimate, 0.0), surface=c.channel)
+    if e == "sensor_offset" and c.channel == "accelerometer":
+        pos = tuple(float(v) for v in c.details["position_ft"])
+        return HiddenEffect(e, pos[0], position_ft=pos)
+    if e in ("sensor_bias", "sensor_scale", "sensor_time_skew") and c.channel in _CHANNEL_COLUMNS:
+        return HiddenEffect(e, c.estimate, channel=c.channel)
+    return None
+
+
+def _findings(analysis: Analysis) -> list[Candidate]:
+    chosen = [c for c in analysis.candidates if c.selected]
+    return sorted(chosen, key=lambda c: -abs(c.t))
+
+
+def _sim_channels(hist) -> dict[str, np.ndarray]:
+    return {c: hist.channels[col] for c, col in _CHANNEL_COLUMNS.items()}
+
+
+def _after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """The coefficient mismatch once the aerodynamic findings' terms are added (their
+    estimated sizes, not refitted: on a validation maneuver this is a prediction)."""
+    p = a.prepared
+    after = {c: v.copy() for c, v in a.mismatch.items()}
+    n_terms = {c: 0 for c in COEFFICIENTS}
+    measured = {c: a.mismatch[c] + a.aero.coefficients[c] for c in COEFFICIENTS}
+    for f in findings:
+        if f.effect == "control_delay":
+            s = f.channel
+            for c in cand.SURFACE_AXES[s]:
+                d = a.aero.derivatives.get(f"{c}_{s}", 0.0)
+                if d:
+                    x = p.smooth[s]
+                    after[c] = after[c] - d * (np.interp(p.t - f.estimate, p.t, x) - x)
+                    n_terms[c] += 1
+            continue
+        if f.channel not in COEFFICIENTS:
+            continue
+        terms = {t.parameter if t.effect != "coefficient_error" else t.parameter: t
+                 for t in cand.library(p, f.channel, a.aero.derivatives, measured)}
+        term = terms.get(f.parameter)
+        if term is None:
+            continue
+        coef = f.details.get("change", f.estimate / term.scale)
+        after[f.channel] = after[f.channel] - coef * term.column
+        n_terms[f.channel] += 1
+    return after, n_terms
+
+
+def _apply_offset(a: Analysis, findings: list[Candidate], mismatch: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    out = dict(mismatch)
+    for f in findings:
+        if f.effect == "sensor_offset" and f.channel == "accelerometer":
+            cols = cand.accelerometer_columns(a.prepared)
+            for i, ax in enumerate("xyz"):
+                for c in ("CX", "CY", "CZ"):
+                    out[c] = out[c] - f.details["position_ft"][i] * cols[ax][c]
+    return out
+
+
+def _maneuver(rec, name: str, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
+              findings: list[Candidate] | None, ident: Analysis | None):
+    """Replays before/after and fits for one maneuver. With ``ident`` given this is the
+    identification maneuver (already analysed); otherwise it is analysed here for its
+    mismatch, and the identification's findings are applied as predictions."""
+    p = prepare(rec, name)
+    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
+    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
+    before_hist, _ = replay(aircraft, ic, p.t, surfaces)
+    after_hist = before_hist
+    if added:
+        after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), ic, p.t, surfaces)
+    a = ident
+    if a is None:
+        from harness.diagnosis.analysis import analyse as _an
+        a = _an(p, aircraft, ic)
+        # the validation's own sensor corrections are not the identification's: undo them
+    before_mm = a.mismatch if ident is not None else a.mismatch
+    after_mm, n_terms = _after_mismatch(a, findings or [])
+    if ident is None:
+        before_mm = dict(a.mismatch)
+    k = max(1, int(round(1.0 / p.dt)))
+    inner = slice(k, p.n - k)
+    sim_b, sim_a = _sim_channels(before_hist), _sim_channels(after_hist)
+    fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner),
+             "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
+    fit_a = {"outputs": output_fit(p.smooth, p.raw, sim_a, OUTPUTS, inner),
+             "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
+    series = {"t_s": p.t}
+    for c in OUTPUTS:
+        if c in p.raw:
+            series[f"meas_{c}"] = p.raw[c]
+            series[f"smooth_{c}"] = p.smooth[c]
+            series[f"before_{c}"] = sim_b[c]
+            series[f"after_{c}"] = sim_a[c]
+    for c in COEFFICIENTS:
+        series[f"coef_meas_{c}"] = a.mismatch[c] + a.aero.coefficients[c]
+        series[f"coef_model_{c}"] = a.aero.coefficients[c]
+        series[f"coef_after_{c}"] = a.aero.coefficients[c] + (a.mismatch[c] - after_mm[c])
+    for s in SURFACES:
+        if s in p.raw:
+            series[s] = p.raw[s]
+    return a, fit_b, fit_a, pd.DataFrame(series)
+
+
+def _located(a: Analysis, fit_b: dict, name: str) -> dict:
+    p = a.prepared
+    outs = {}
+    for c, v in fit_b["outputs"].items():
+        n = p.noise_std.get(c, 0.0)
+        outs[c] = {**v, "noise_std": n, "ratio": v["rms"] / n if n > 0 else float("inf")}
+    coefs = {}
+    for c in COEFFICIENTS:
+        r = a.mismatch[c] - np.mean(a.mismatch[c])
+        coefs[c] = {"rms": float(np.std(r)), "noise_std": a.noise[c], "ratio": float(np.std(r)) / a.noise[c],
+                    "pse": fit_b["coefficients"][c]["pse"]}
+    worst_axis = max(coefs, key=lambda c: coefs[c]["ratio"])
+    worst_out = max(outs, key=lambda c: outs[c]["ratio"]) if outs else None
+    r = a.mismatch[worst_axis] - np.mean(a.mismatch[worst_axis])
+    # when: the 2 s window with the largest mismatch energy; where: the band holding most power
+    w = max(1, int(round(2.0 / p.dt)))
+    energy = np.convolve(r ** 2, np.ones(w), mode="valid")
+    i = int(np.argmax(energy))
+    spec = np.abs(np.fft.rfft(r)) ** 2
+    f = np.fft.rfftfreq(r.size, p.dt)
+    cum = np.cumsum(spec) / max(spec.sum(), 1e-300)
+    band = [float(f[int(np.searchsorted(cum, 0.1))]), float(f[min(int(np.searchsorted(cum, 0.9)), f.size - 1)])]
+    return {"outputs": {name: outs}, "coefficients": {name: coefs}, "worst_output": worst_out, "worst_axis": worst_axis,
+            "time_window_s": [float(p.t[i]), float(p.t[min(i + w, p.n - 1)])], "band_hz": band,
+            "summary": (f"The largest mismatch is in {worst_axis} ({coefs[worst_axis]['ratio']:.1f} times its noise "
+                        f"level), most between t = {p.t[i]:.1f} and {p.t[min(i + w, p.n - 1)]:.1f} s, with 80 % of its "
+                        f"power in {band[0]:.2f}-{band[1]:.2f} Hz; of the outputs, {worst_out} departs most from the "
+                        f"model ({outs[worst_out]['ratio']:.1f} times its noise)." if worst_out else "")}
+
+
+def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict) -> dict:
+    fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
+           "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
+    if c.effect == "coefficient_error":
+        fmt["model_value"] = c.estimate - c.details["change"]
+    try:
+        text = EXPLAIN[c.effect].format(**fmt)
+    except (KeyError, ValueError):
+        text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
+    evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
+    evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
+    return {"effect": c.effect, "axis": c.axis if c.axis in ("pitch", "roll", "yaw", "lon", "lat") else None,
+            "channel": c.channel, "parameter": c.parameter, "estimate": float(c.estimate),
+            "std_error": float(c.std_error), "units": c.units, "evidence": evidence,
+            "fit_before": fits_b, "fit_after": fits_a, "explanation": text}
+
+
+def _none_finding(a: Analysis, fits_b: dict) -> dict:
+    top = sorted(a.candidates, key=lambda c: -abs(c.t))[:5]
+    ratios = {c: round(float(np.std(a.mismatch[c] - a.mismatch[c].mean()) / a.noise[c]), 2) for c in COEFFICIENTS}
+    return {"effect": "none", "axis": None, "channel": None, "parameter": "", "estimate": 0.0, "std_error": 0.0,
+            "units": "", "evidence": {
+                "strongest_candidates": [{"effect": c.effect, "parameter": c.parameter, "t": c.t,
+                                          "explained_fraction": c.explained_fraction, "reason": c.reason} for c in top],
+                "entry_t": cand.T_IN, "mismatch_to_noise": ratios},
+            "fit_before": fits_b, "fit_after": fits_b,
+            "explanation": "No candidate effect is significant against the noise the data themselves show: the "
+                           "mismatch is explained by measurement noise alone."}
+
+
+def diagnose(model: str, recording: str | Path, out: str | Path, validation: str | Path | None = None) -> dict:
+    """Diagnose ``recording`` against ``model``; write ``out``; return findings.json's content.
+
+    Raises
+    ------
+    DiagnosisError
+        For an unknown model; recording, trim and flight errors name their cause themselves.
+    """
+    t0 = time.perf_counter()
+    out = Path(out)
+    aircraft = _aircraft(model)
+    rec = read_recording(recording)
+    p = prepare(rec, "identification")
+    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
+    a = analyse(p, aircraft, ic)
+    findings = _findings(a)
+    added = tuple(e for e in (_effect_of(f) for f in findings) if e is not None)
+    timing = {"analysis": time.perf_counter() - t0}
+    _, fb_id, fa_id, series_id = _maneuver(rec, "identification", aircraft, added, findings, a)
+    fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
+    series = {"identification": series_id}
+    located = _located(a, fb_id, "identification")
+    if validation is not None:
+        vrec = read_recording(validation)
+        av, fb_v, fa_v, series_v = _maneuver(vrec, "validation", aircraft, added, findings, None)
+        fits_b["validation"], fits_a["validation"] = fb_v, fa_v
+        series["validation"] = series_v
+        located["outputs"]["validation"] = _located(av, fb_v, "validation")["outputs"]["validation"]
+    timing["total"] = time.perf_counter() - t0
+    model_info = _write_model(out, aircraft, ic, added)
+    result = {
+        "findings": [_finding_dict(f, fits_b, fits_a) for f in findings] or [_none_finding(a, fits_b)],
+        "located": located,
+        "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
+        "candidates": [c.as_dict() for c in sorted(a.candidates, key=lambda c: -abs(c.t))],
+        "model": model_info,
+        "inputs": {"identification": str(recording), "validation": str(validation) if validation else None,
+                   "model": model},
+        "common_filter_cutoff_hz": p.common_cutoff_hz,
+        "timing_s": timing,
+        "seed": None,
+    }
+    (out / "series").mkdir(parents=True, exist_ok=True)
+    for name, df in series.items():
+        write_atomic(out / "series" / f"{name}.parquet", lambda fh, df=df: df.to_parquet(fh, index=False))
+    write_text_atomic(out / "findings.json", json.dumps(_jsonable(result), indent=1))
+    return result
+
+
+def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ...]) -> dict:
+    """Copy the augmented aircraft (XML) into ``out/model``; sensor effects are listed in
+    ``sensors.json`` beside it (they change what the instruments record, not the flight)."""
+    dest = out / "model"
+    dest.mkdir(parents=True, exist_ok=True)
+    terms = [e.describe() | {"parameter": e.parameter} for e in added]
+    sensors = [t for t, e in zip(terms, added) if e.effect.startswith("sensor_")]
+    write_text_atomic(dest / "sensors.json", json.dumps(sensors, indent=1))
+    if not any(not e.effect.startswith("sensor_") for e in added):
+        return {"base": aircraft.model, "augmented_xml": None, "terms": terms,
+                "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
+    root, name = hidden_root(Aircraft(aircraft.model, hidden=added), ic.condition())
+    src = root / "aircraft" / name / f"{name}.xml"
+    target = dest / f"{aircraft.model}-diagnosed.xml"
+    write_atomic(target, lambda fh: fh.write(src.read_bytes()))
+    return {"base": aircraft.model, "augmented_xml": str(target.relative_to(out)), "terms": terms,
+            "note": ("a control delay is a property (sidbench/<surface>-delay-delta-rad) the sidbench flight loop "
+                     "drives; the aerodynamic terms fly in any JSBSim")}
+
+
+def _jsonable(x):
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, (np.floating, float)):
+        v = float(x)
+        return v if np.isfinite(v) else None
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    return x

@@ -1,0 +1,157 @@
+"""A model under test, set against a recording: trim to its initial condition, replay its
+measured surfaces, and evaluate the model's aerodynamics along its measured states.
+
+These are the simulation halves of the discrepancy diagnosis (``harness.diagnosis``): the
+recording supplies the inputs and states, this module says what the model makes of them.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from models.aircraft import Aircraft, load_fdm
+from models.conditions import FlightCondition
+from models.flight import FlightHistory, fly
+from models.hidden import hidden_root, needs_copy
+from models.trim import TrimPoint, trim
+from models.truth import CoefficientProbe, central_differences, differencing_instance
+
+SURFACES = ("de", "da", "dr")
+# Recorded state names (canonical quantity) the aerodynamics are evaluated at.
+STATE_NAMES = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "h")
+
+
+@dataclass(frozen=True)
+class InitialCondition:
+    """Where the recording starts: the model is trimmed wings-level here."""
+
+    h_ft: float
+    V_fps: float
+    alpha_rad: float = 0.0  # the recording's own α at the start (a reference, not imposed)
+
+    def condition(self) -> FlightCondition:
+        return FlightCondition("recording", self.h_ft, self.V_fps, "the recording's initial condition")
+
+
+def _instance(aircraft: Aircraft, ic: InitialCondition, refs: Mapping[str, float] | None):
+    cond = ic.condition()
+    kwargs: dict = {}
+    if aircraft.hidden and needs_copy(tuple(aircraft.hidden)):
+        root, name = hidden_root(aircraft, cond, dict(refs or {}))
+        kwargs = {"root": root, "name": name}
+    return cond, kwargs
+
+
+def trim_at(aircraft: Aircraft, ic: InitialCondition, refs: Mapping[str, float] | None = None) -> TrimPoint:
+    """Trim ``aircraft`` (with any added physics) at the recording's initial condition."""
+    cond, kwargs = _instance(aircraft, ic, refs)
+    return trim(load_fdm(aircraft, 1 / 120, **kwargs), aircraft, cond)
+
+
+def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Mapping[str, np.ndarray], *,
+           refs: Mapping[str, float] | None = None, sim_rate_hz: float = 120.0) -> tuple[FlightHistory, TrimPoint]:
+    """Fly ``aircraft`` from trim at ``ic`` with the recording's surface motions.
+
+    Each surface moves by the recorded change from its first sample (linear interpolation
+    between samples onto the simulation frames), about the model's own trim position: a
+    model that needs another trim deflection still starts in equilibrium.
+
+    Raises
+    ------
+    models.trim.TrimError, models.flight.FlightError
+        When the model cannot trim there or diverges while replaying.
+    """
+    cond, kwargs = _instance(aircraft, ic, refs)
+    fdm = load_fdm(aircraft, 1 / 120, **kwargs)
+    tp = trim(fdm, aircraft, cond)
+    t = np.asarray(t, dtype=float)
+    moves = {s: np.asarray(x, dtype=float) - float(x[0]) for s, x in surfaces.items() if s in SURFACES}
+    rel = t - t[0]
+
+    def deflections(tf: np.ndarray) -> dict[str, np.ndarray]:
+        return {s: np.interp(tf, rel, x) for s, x in moves.items()}
+
+    dt = float(np.median(np.diff(t)))
+    hist = fly(fdm, aircraft, tp, deflections, rel[-1], sample_rate_hz=1.0 / dt, sim_rate_hz=sim_rate_hz)
+    return hist, tp
+
+
+@dataclass(frozen=True)
+class AeroAlong:
+    """The model's aerodynamic coefficients along a recording's states.
+
+    ``coefficients[C]`` per sample (C in CX, CY, CZ, Cl, Cm, Cn, about the c.g.);
+    ``derivatives`` the model's local slopes at the trim point (truth.central_differences
+    names, e.g. ``Cm_alpha``, per rad, rates normalised); ``unsteady`` its α̇ derivatives.
+    """
+
+    coefficients: dict[str, np.ndarray]
+    derivatives: dict[str, float]
+    unsteady: dict[str, float]
+    trim: TrimPoint
+
+
+def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np.ndarray],
+               surfaces: Mapping[str, np.ndarray], alphadot: np.ndarray | None = None, *,
+               refs: Mapping[str, float] | None = None) -> AeroAlong:
+    """Evaluate the model's aerodynamics at every recorded state (one ``run_ic`` per sample).
+
+    ``states`` holds ``V, alpha, beta, p, q, r, phi, theta`` (and optionally ``h``) in the
+    canonical units; ``surfaces`` absolute positions ``de, da, dr`` (rad). Any α̇ term of the
+    model is gated off for the evaluation and added back as its α̇ derivative times the
+    recorded ``alphadot`` (rad/s), since ``run_ic`` cannot know the α̇ of a recorded sample.
+    """
+    cond, kwargs = _instance(aircraft, ic, refs)
+    fdm, tp, gated = differencing_instance(aircraft, cond, **kwargs)
+    probe = CoefficientProbe(fdm, aircraft, tp, gated)
+    derivatives = central_differences(probe)
+    unsteady = probe.unsteady_derivatives()
+    n = len(states["V"])
+    h = np.asarray(states.get("h", np.full(n, ic.h_ft)), dtype=float)
+    cols = {k: np.asarray(states[k], dtype=float) for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta")}
+    surf = aircraft.surfaces
+    trim_surface = {"de": tp.de_rad, "da": tp.da_rad, "dr": tp.dr_rad}
+    sv = {s: np.asarray(surfaces.get(s, np.full(n, trim_surface[s])), dtype=float) for s in SURFACES}
+    pm = fdm.get_property_manager()
+    setters = {p: pm.get_node(p).set_double_value for p in
+               ("ic/h-sl-ft", "ic/vt-fps", "ic/alpha-rad", "ic/beta-rad", "ic/theta-rad", "ic/phi-rad",
+                "ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", surf["de"], surf["da"], surf["dr"])}
+    out = {c: np.empty(n) for c in ("CX", "CY", "CZ", "Cl", "Cm", "Cn")}
+    fdm["ic/lat-gc-deg"] = 0.0
+    fdm["ic/long-gc-deg"] = 0.0
+    for k in range(n):
+        setters["ic/h-sl-ft"](float(h[k]))
+        setters["ic/vt-fps"](float(cols["V"][k]))
+        setters["ic/alpha-rad"](float(cols["alpha"][k]))
+        setters["ic/beta-rad"](float(cols["beta"][k]))
+        setters["ic/theta-rad"](float(cols["theta"][k]))
+        setters["ic/phi-rad"](float(cols["phi"][k]))
+        setters["ic/p-rad_sec"](float(cols["p"][k]))
+        setters["ic/q-rad_sec"](float(cols["q"][k]))
+        setters["ic/r-rad_sec"](float(cols["r"][k]))
+        for s in SURFACES:
+            setters[surf[s]](float(sv[s][k]))
+        fdm.run_ic()
+        row = probe.read()
+        for c in out:
+            out[c][k] = row[c]
+    if unsteady and alphadot is not None:
+        adot_hat = np.asarray(alphadot, dtype=float) * tp.cbar_ft / (2.0 * cols["V"])
+        for c in ("CX", "CZ", "Cm"):
+            out[c] = out[c] + unsteady.get(f"{c}_alphadot", 0.0) * adot_hat
+    bad = [c for c, v in out.items() if not np.all(np.isfinite(v))]
+    if bad:
+        raise ValueError(f"the model's aerodynamics are not finite along the recording ({', '.join(bad)}); "
+                         "the recorded states leave the model's tables")
+    return AeroAlong(coefficients=out, derivatives=derivatives, unsteady=unsteady, trim=tp)
+
+
+def initial_condition(t: np.ndarray, V: np.ndarray, alpha: np.ndarray, h: np.ndarray | None,
+                      window_s: float = 0.5) -> InitialCondition:
+    """The recording's initial condition: means over its first ``window_s`` seconds."""
+    k = max(1, int(math.ceil(window_s / float(np.median(np.diff(t))))))
+    return InitialCondition(h_ft=float(np.mean(h[:k])) if h is not None else 10_000.0,
+                            V_fps=float(np.mean(V[:k])), alpha_rad=float(np.mean(alpha[:k])))

@@ -1,0 +1,142 @@
+"""The discrepancy diagnosis: the concealed-effect gallery, the null recording, the pieces
+pinned to analytic truth, and the command line."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from estimators.colored_stepwise import colored_forward_selection
+from estimators.smoothing import sine_series_derivative
+from harness.diagnosis.fits import theil_u, whiteness
+from harness.diagnosis.gallery import CASES, case, write_case
+from harness.diagnosis.run import DiagnosisError, diagnose
+
+AFFECTED = {"unsteady_alphadot": "q", "control_delay": "q", "sensor_offset": "az", "nonlinear_alpha": "q"}
+
+
+@pytest.fixture(scope="module")
+def gallery(tmp_path_factory):
+    root = tmp_path_factory.mktemp("gallery")
+    out = {}
+    for c in CASES:
+        paths = write_case(c, root / "recordings", seed=1)
+        out[c.name] = diagnose("f16", paths["identification"], root / c.name, paths["validation"])
+    return out
+
+
+@pytest.mark.parametrize("name", ["unsteady_alphadot", "control_delay", "sensor_offset", "nonlinear_alpha"])
+def test_gallery_names_the_effect_first_and_recovers_its_size(gallery, name):
+    c = case(name)
+    first = gallery[name]["findings"][0]
+    assert first["effect"] == name
+    assert first["parameter"] == c.parameter
+    err = abs(first["estimate"] - c.truth)
+    assert err <= max(first["std_error"], 0.25 * abs(c.truth)), (first["estimate"], first["std_error"], c.truth)
+    assert first["explanation"] and first["evidence"]["t"]
+
+
+@pytest.mark.parametrize("name", ["unsteady_alphadot", "control_delay", "sensor_offset", "nonlinear_alpha"])
+def test_gallery_fit_improves_on_the_validation_maneuver(gallery, name):
+    f = gallery[name]["findings"][0]
+    ch = AFFECTED[name]
+    before = f["fit_before"]["validation"]["outputs"][ch]["rms"]
+    after = f["fit_after"]["validation"]["outputs"][ch]["rms"]
+    assert after < 0.8 * before, (before, after)
+
+
+def test_gallery_null_recording_gives_none(gallery):
+    findings = gallery["none"]["findings"]
+    assert [f["effect"] for f in findings] == ["none"]
+    assert findings[0]["evidence"]["strongest_candidates"]
+    assert all(abs(c["t"]) < 6 or not c["selected"] for c in gallery["none"]["candidates"])
+
+
+def test_findings_json_shape(gallery, tmp_path):
+    r = gallery["unsteady_alphadot"]
+    assert set(r) >= {"findings", "located", "noise"}
+    f = r["findings"][0]
+    assert set(f) >= {"effect", "axis", "channel", "parameter", "estimate", "std_error", "units", "evidence",
+                      "fit_before", "fit_after", "explanation"}
+    assert f["axis"] in ("pitch", "roll", "yaw", "lon", "lat", None)
+    assert set(f["fit_before"]) == {"identification", "validation"}
+    assert r["noise"]["q"]["std"] > 0
+    assert r["located"]["time_window_s"][0] < r["located"]["time_window_s"][1]
+
+
+def test_augmented_model_is_written(gallery, tmp_path_factory):
+    r = gallery["unsteady_alphadot"]
+    assert r["model"]["augmented_xml"].endswith(".xml")
+    assert r["model"]["terms"][0]["effect"] == "unsteady_alphadot"
+
+
+def test_unknown_model_is_refused(tmp_path):
+    with pytest.raises(DiagnosisError, match="not one of the project's models"):
+        diagnose("gremlin", tmp_path / "x.csv", tmp_path / "out")
+
+
+# -- pieces against analytic truth -----------------------------------------------------------
+
+def test_sine_series_derivative_of_a_known_signal():
+    t = np.arange(1001) * 0.02
+    x = np.sin(2 * np.pi * 0.5 * t) + 0.3 * t
+    d = sine_series_derivative(x, np.ones(999), 0.02)
+    assert np.max(np.abs(d - (np.pi * np.cos(np.pi * t) + 0.3))[50:-50]) < 1e-9
+
+
+def test_colored_selection_finds_the_true_term_and_nothing_in_noise():
+    rng = np.random.default_rng(3)
+    n = 2000
+    t = np.arange(n) * 0.02
+    a = np.sin(2 * np.pi * 0.3 * t)
+    b = np.cos(2 * np.pi * 0.7 * t + 0.4)
+    c = np.sign(np.sin(2 * np.pi * 0.1 * t))
+    z = 0.5 * b + rng.normal(0, 0.1, n)
+    sel = colored_forward_selection(z, {"a": a, "b": b, "c": c})
+    assert sel.names == ("b",)
+    assert abs(sel.params["b"] - 0.5) < 4 * sel.std_errors["b"]
+    hits = 0
+    for k in range(20):  # pure noise: nothing enters (|t| >= 5 has probability ~6e-7 per term)
+        noise = np.random.default_rng(100 + k).normal(0, 1, n)
+        hits += len(colored_forward_selection(noise, {"a": a, "b": b, "c": c}).names)
+    assert hits == 0
+
+
+def test_theil_u_and_whiteness():
+    y = np.array([1.0, -1.0, 1.0, -1.0])
+    assert theil_u(y, y) == 0.0
+    assert math.isclose(theil_u(y, -y), 1.0)
+    w = whiteness(np.random.default_rng(0).normal(size=5000))
+    assert w["lag_fraction_inside"] >= 0.8 and abs(w["lag1"]) < 0.05
+    assert whiteness(np.sin(np.arange(5000) * 0.01))["lag_fraction_inside"] == 0.0
+
+
+def test_structural_peak_found_in_noise(tmp_path):
+    from harness.diagnosis.prepare import prepare
+    from harness.diagnosis.spectra import structural_peak
+    from harness.recording_io import read_recording
+    paths = write_case(case("none"), tmp_path, seed=5)
+    rec = read_recording(paths["identification"])
+    clean = structural_peak(prepare(rec))
+    assert clean is None or clean.p_value > 1e-6
+    t = rec.data["t_s"].to_numpy()
+    rec.data["q_rps"] = rec.data["q_rps"] + 0.004 * np.sin(2 * np.pi * 7.3 * t)
+    peak = structural_peak(prepare(rec))
+    assert peak.p_value < 1e-6 and abs(peak.frequency_hz - 7.3) < 0.1
+
+
+def test_cli_diagnose_writes_report(tmp_path, capsys):
+    from harness.cli import main
+    paths = write_case(case("control_delay"), tmp_path / "rec", seed=1)
+    rc = main(["diagnose", "--model", "f16", "--recording", str(paths["identification"]),
+               "--out", str(tmp_path / "out")])
+    assert rc == 0
+    assert "control_delay" in capsys.readouterr().out
+    data = json.loads((tmp_path / "out" / "findings.json").read_text())
+    assert data["findings"][0]["effect"] == "control_delay"
+    assert "validation" not in data["findings"][0]["fit_before"]
+    assert (tmp_path / "out" / "report.html").stat().st_size > 10_000
+    xml = (tmp_path / "out" / data["model"]["augmented_xml"]).read_text()
+    assert "de-delay-delta-rad" in xml
