@@ -43,7 +43,17 @@ _B737 = (
     FlightCondition("cruise", 30_000.0, 750.0, "737 cruise_init.xml: 30,000 ft, 750 ft/s"),
 )
 
-_CONDITIONS: dict[str, tuple[FlightCondition, ...]] = {"f16": _F16, "737": _B737}
+# The JSBSim DHC6 (Twin Otter) at the condition of the SIDPAC Twin Otter flight-test recordings
+# (../shared/data/sidpac/totter_f1_*: lateral maneuvers): the means of totter_f1_017 (the
+# identification record; 20 s, V 231-243 ft/s, h 6,187-6,266 ft, qbar 56.3 psf). 014 (the
+# validation record) flew 237.7 ft/s at 6,299 ft, close enough to share it. The recording's
+# mass (339.3 slug) and inertia differ from the JSBSim model's (314.4 slug): models.mass.
+_DHC6 = (
+    FlightCondition("twin-otter-017", 6_223.0, 237.0,
+                    "SIDPAC Twin Otter record 017 (lateral, alpha near 0): mean h 6,223 ft, V 237.0 ft/s"),
+)
+
+_CONDITIONS: dict[str, tuple[FlightCondition, ...]] = {"f16": _F16, "737": _B737, "dhc6": _DHC6}
 
 
 def conditions_for(model: str) -> tuple[FlightCondition, ...]:

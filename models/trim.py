@@ -5,7 +5,7 @@ from dataclasses import asdict, dataclass
 
 import jsbsim
 
-from models.aircraft import Aircraft, place_reference_point
+from models.aircraft import TRIM_MOMENT_PROPERTIES, TURBOPROP_MODELS, Aircraft, place_reference_point
 from models.conditions import FlightCondition
 
 G0_FPS2 = 32.17404855643  # standard gravity, ft/s^2 (9.80665 m/s^2)
@@ -100,6 +100,11 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     follows. The aircraft's reference-point rule is applied before trimming. Fuel is frozen
     afterwards so mass and c.g. stay put.
 
+    Turboprops (``TURBOPROP_MODELS``: the DHC6) deliver no shaft power while JSBSim trims,
+    so they are re-trimmed with their propeller torque applied as external moments
+    (:func:`_trim_with_propeller_torque`) and their engines left running at steady state
+    (:func:`settle_engines`): flown from here, the first frame is in equilibrium.
+
     Raises
     ------
     TrimError
@@ -111,12 +116,15 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     fdm.run_ic()
     if place_reference_point(fdm, aircraft):
         fdm.run_ic()
+    turboprop = aircraft.model in TURBOPROP_MODELS
     try:
         fdm.do_trim(0)
         lateral = max(abs(fdm["accelerations/pdot-rad_sec2"]), abs(fdm["accelerations/rdot-rad_sec2"]),
                       abs(fdm["accelerations/vdot-ft_sec2"]))
         if lateral > 1e-6:
             fdm.do_trim(1)
+        if turboprop:
+            _trim_with_propeller_torque(fdm)
     except jsbsim.TrimFailureError as exc:
         hint = ""
         if aircraft.model == "f16" and 420.0 < condition.V_fps < 432.0 and abs(condition.h_ft - 10_000) < 2_000:
@@ -126,4 +134,53 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
         raise TrimError(f"trim failed for {aircraft.label} at {condition.name!r} "
                         f"(h = {condition.h_ft:.0f} ft, V = {condition.V_fps:.1f} ft/s): {exc}.{hint}") from exc
     fdm["propulsion/fuel_freeze"] = 1
+    if turboprop:
+        settle_engines(fdm)
     return read_trim_point(fdm, condition.name, aircraft.surfaces)
+
+
+_PROP_MOMENTS = ("moments/l-prop-lbsft", "moments/m-prop-lbsft", "moments/n-prop-lbsft")
+
+
+def settle_engines(fdm: jsbsim.FGFDMExec) -> None:
+    """Put a trimmed turboprop's engines into their running steady state.
+
+    JSBSim's turboprop (FGTurboProp) has a 'trim' phase whenever the time step is zero
+    (trim, ``run_ic``) in which it delivers no shaft power, and on the first frame after it
+    resets N1 to idle: flown straight after a trim, the DHC6's thrust would drop by half in
+    0.8 s and take ~8 s to recover. ``FGPropulsion::GetSteadyState`` marches the engines
+    (alone, 0.5 s steps) to steady state and leaves them running, so the first frame flies
+    the trimmed thrust with its shaft power and torque. Call it again after any later
+    ``run_ic`` of a turboprop that is to be flown.
+    """
+    fdm.get_propulsion().get_steady_state()
+
+
+def _trim_with_propeller_torque(fdm: jsbsim.FGFDMExec, iterations: int = 8, tol_lbsft: float = 1e-3) -> None:
+    """Re-trim a turboprop with its propeller torque stood in for by external moments.
+
+    During JSBSim's trim the turboprop delivers no shaft power, hence no propeller torque
+    (for the DHC6 at 6,000 ft about -2,700 lbf*ft of roll, both propellers turning the same
+    way), yet it flies with it: the moments of the running engines minus those of the trim
+    are applied as body-axis external moments (``TRIM_MOMENT_PROPERTIES``) and the trim
+    repeated until they stop changing (the throttle, hence the power, moves a little). The
+    moments are zeroed afterwards; the caller then runs :func:`settle_engines`, after which
+    the real torque replaces them.
+    """
+    extra = [0.0, 0.0, 0.0]
+    for _ in range(iterations):
+        trimmed = [fdm[p] for p in _PROP_MOMENTS]
+        settle_engines(fdm)
+        running = [fdm[p] for p in _PROP_MOMENTS]
+        new = [r - t for r, t in zip(running, trimmed)]
+        change = max(abs(a - b) for a, b in zip(new, extra))
+        extra = new
+        if change < tol_lbsft:
+            break
+        for prop, v in zip(TRIM_MOMENT_PROPERTIES.values(), extra):
+            fdm[prop] = v
+        fdm.do_trim(1)
+    else:
+        raise jsbsim.TrimFailureError(f"the propeller torque did not settle in {iterations} re-trims")
+    for prop in TRIM_MOMENT_PROPERTIES.values():
+        fdm[prop] = 0.0
