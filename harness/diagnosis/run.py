@@ -14,7 +14,6 @@ from harness.atomic import write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
-from harness.diagnosis.kinematics import corrected_channels
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
 from harness.recording_io import read_recording
 from models.aircraft import MODELS, Aircraft
@@ -126,17 +125,6 @@ def _after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, n
     return after, n_terms
 
 
-def _apply_offset(a: Analysis, findings: list[Candidate], mismatch: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    out = dict(mismatch)
-    for f in findings:
-        if f.effect == "sensor_offset" and f.channel == "accelerometer":
-            cols = cand.accelerometer_columns(a.prepared)
-            for i, ax in enumerate("xyz"):
-                for c in ("CX", "CY", "CZ"):
-                    out[c] = out[c] - f.details["position_ft"][i] * cols[ax][c]
-    return out
-
-
 def _maneuver(rec, name: str, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
               findings: list[Candidate] | None, ident: Analysis | None):
     """Replays before/after and fits for one maneuver. With ``ident`` given this is the
@@ -149,15 +137,9 @@ def _maneuver(rec, name: str, aircraft: Aircraft, added: tuple[HiddenEffect, ...
     after_hist = before_hist
     if added:
         after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), ic, p.t, surfaces)
-    a = ident
-    if a is None:
-        from harness.diagnosis.analysis import analyse as _an
-        a = _an(p, aircraft, ic)
-        # the validation's own sensor corrections are not the identification's: undo them
-    before_mm = a.mismatch if ident is not None else a.mismatch
+    a = ident if ident is not None else analyse(p, aircraft, ic)
+    before_mm = a.mismatch
     after_mm, n_terms = _after_mismatch(a, findings or [])
-    if ident is None:
-        before_mm = dict(a.mismatch)
     k = max(1, int(round(1.0 / p.dt)))
     inner = slice(k, p.n - k)
     sim_b, sim_a = _sim_channels(before_hist), _sim_channels(after_hist)
