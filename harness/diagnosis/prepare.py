@@ -113,7 +113,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     k = max(1, int(round(START_WINDOW_S / dt)))
     start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
     cutoff = float(np.max(np.nonzero(w > 1e-6)[0], initial=0) + 1) / (2.0 * t[-1])
-    measured = measured_coefficients(smooth, deriv, rec.meta, start)
+    measured = measured_coefficients(smooth, deriv, rec.meta)
     return Prepared(name=name, t=t, dt=dt, raw=raw, smooth=smooth, deriv=deriv, noise_std=noise,
                     cutoff_hz={c: f.cutoff_hz for c, f in fits.items()}, weights=w, common_cutoff_hz=cutoff,
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
@@ -121,7 +121,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
 
 
 def measured_coefficients(s: dict[str, np.ndarray], d: dict[str, np.ndarray], meta: dict,
-                          start: dict[str, float], thrust_lbf: float | None = None) -> dict[str, np.ndarray]:
+                          thrust_lbf: float | None = None) -> dict[str, np.ndarray]:
     """Seed Eqs. 1 and 3-5 from filtered channels ``s`` and their derivatives ``d``.
 
     Thrust is the recorded channel when present, else ``thrust_lbf`` (the model's trim

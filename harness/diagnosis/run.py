@@ -125,12 +125,11 @@ def _after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, n
     return after, n_terms
 
 
-def _maneuver(rec, name: str, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
+def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
               findings: list[Candidate] | None, ident: Analysis | None):
     """Replays before/after and fits for one maneuver. With ``ident`` given this is the
     identification maneuver (already analysed); otherwise it is analysed here for its
     mismatch, and the identification's findings are applied as predictions."""
-    p = prepare(rec, name)
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     before_hist, _ = replay(aircraft, ic, p.t, surfaces)
@@ -242,13 +241,15 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
     findings = _findings(a)
     added = tuple(e for e in (_effect_of(f) for f in findings) if e is not None)
     timing = {"analysis": time.perf_counter() - t0}
-    _, fb_id, fa_id, series_id = _maneuver(rec, "identification", aircraft, added, findings, a)
+    # the recording as prepared (``a.prepared`` carries the sensor corrections; fits are
+    # against what was recorded)
+    _, fb_id, fa_id, series_id = _maneuver(p, aircraft, added, findings, a)
     fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
     series = {"identification": series_id}
     located = _located(a, fb_id, "identification")
     if validation is not None:
         vrec = read_recording(validation)
-        av, fb_v, fa_v, series_v = _maneuver(vrec, "validation", aircraft, added, findings, None)
+        av, fb_v, fa_v, series_v = _maneuver(prepare(vrec, "validation"), aircraft, added, findings, None)
         fits_b["validation"], fits_a["validation"] = fb_v, fa_v
         series["validation"] = series_v
         located["outputs"]["validation"] = _located(av, fb_v, "validation")["outputs"]["validation"]
