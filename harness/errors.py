@@ -4,6 +4,7 @@ from __future__ import annotations
 from estimators.least_squares import SingularRegressorsError
 from estimators.regressors import EquationError
 from harness.campaign import CampaignError
+from harness.diagnosis.run import DiagnosisError
 from maneuvers.base import InputSpecError
 from maneuvers.recording import RecordingError
 from models.flight import FlightError
@@ -11,4 +12,4 @@ from models.trim import TrimError
 
 USER_ERRORS: tuple[type[BaseException], ...] = (
     RecordingError, TrimError, FlightError, InputSpecError, SingularRegressorsError, EquationError, CampaignError,
-    FileNotFoundError, ValueError)
+    DiagnosisError, FileNotFoundError, ValueError)

@@ -121,7 +121,8 @@ def to_recording(spec: FlightSpec, hist: FlightHistory, tp: TrimPoint, truth: De
         data[f"truth_{name}_{units.get(name, '1')}"] = values
     meta = {
         "format": FORMAT_ID,
-        "aircraft": {"f16": "F-16", "737": "Boeing 737"}[spec.aircraft.model],
+        "aircraft": {"f16": "F-16", "737": "Boeing 737", "dhc6": "DHC-6 Twin Otter"}.get(
+            spec.aircraft.model, spec.aircraft.name),
         "geometry": {"S_ft2": tp.S_ft2, "b_ft": tp.b_ft, "cbar_ft": tp.cbar_ft},
         "mass": {"mass_slug": tp.mass_slug, "Ix_slugft2": tp.Ix_slugft2, "Iy_slugft2": tp.Iy_slugft2,
                  "Iz_slugft2": tp.Iz_slugft2, "Ixz_slugft2": tp.Ixz_slugft2},

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import jsbsim
 
-from models.jsbsim_root import aircraft_xml, cached_root, strip_io
+from models.jsbsim_root import aircraft_xml, cached_root, engine_root, package_root, strip_io
 
 VARIANTS = ("nominal", "exact-truth", "unstable")
 MODELS = ("f16", "737", "dhc6")
@@ -25,6 +25,15 @@ SURFACE_PROPERTIES: dict[str, dict[str, str]] = {
     "f16": {"de": "fcs/elevator-pos-rad", "da": "fcs/aileron-pos-rad", "dr": "fcs/rudder-pos-rad"},
     "737": {"de": "fcs/elevator-pos-rad", "da": "fcs/left-aileron-pos-rad", "dr": "fcs/rudder-pos-rad"},
     "dhc6": {"de": "fcs/elevator-pos-rad", "da": "fcs/left-aileron-pos-rad", "dr": "fcs/rudder-pos-rad"},
+}
+
+# Surface properties an aircraft XML given by path is searched for, in order of preference:
+# the first its aerodynamics read is the surface's.
+SURFACE_CANDIDATES: dict[str, tuple[str, ...]] = {
+    "de": ("fcs/elevator-pos-rad",),
+    "da": ("fcs/aileron-pos-rad", "fcs/left-aileron-pos-rad", "fcs/effective-aileron-pos",
+           "fcs/right-aileron-pos-rad"),
+    "dr": ("fcs/rudder-pos-rad",),
 }
 
 # Models whose engines are JSBSim turboprops: their trim needs models.trim's engine handling.
@@ -67,20 +76,103 @@ class Aircraft:
     hidden: tuple = ()  # models.hidden.HiddenEffect: concealed physics for the discrepancy diagnosis
 
     def __post_init__(self) -> None:
-        if self.model not in MODELS:
-            raise ValueError(f"unknown aircraft {self.model!r}; choose one of {MODELS}")
+        if self.model not in MODELS and not is_xml_model(self.model):
+            raise ValueError(f"unknown aircraft {self.model!r}; choose one of {MODELS} or give the path "
+                             "of a JSBSim aircraft XML (<name>.xml)")
+        if is_xml_model(self.model):
+            if not Path(self.model).is_file():
+                raise ValueError(f"no JSBSim aircraft file {self.model!r}")
+            if self.variant != "nominal":
+                raise ValueError(f"an aircraft given by path flies as it is: variant {self.variant!r} "
+                                 "is only built for the project's models")
         if self.variant not in VARIANTS:
             raise ValueError(f"unknown variant {self.variant!r}; choose one of {VARIANTS}")
 
     @property
     def surfaces(self) -> dict[str, str]:
         """Surface name ('de', 'da', 'dr') to the JSBSim property the aerodynamics read."""
+        if is_xml_model(self.model):
+            return xml_surface_properties(self.model)
         return SURFACE_PROPERTIES[self.model]
 
     @property
+    def name(self) -> str:
+        """The model's short name: 'f16', '737', 'dhc6', or an XML file's stem."""
+        return Path(self.model).stem if is_xml_model(self.model) else self.model
+
+    @property
     def label(self) -> str:
-        base = self.model if self.variant == "nominal" else f"{self.model}/{self.variant}"
+        base = self.name if self.variant == "nominal" else f"{self.name}/{self.variant}"
         return base + "".join(f"+{e.effect}" for e in self.hidden)
+
+
+def is_xml_model(model: str) -> bool:
+    """Whether ``model`` is the path of a JSBSim aircraft XML rather than a project model name."""
+    return str(model).lower().endswith(".xml")
+
+
+def model_xml(model: str) -> Path:
+    """The aircraft XML a model is built from: the package's, or the file given by path."""
+    if is_xml_model(model):
+        return Path(model).resolve()
+    name = PACKAGE_NAMES[model]
+    return package_root() / "aircraft" / name / f"{name}.xml"
+
+
+def is_turboprop(model: str) -> bool:
+    """Whether the model's engines are JSBSim turboprops (they need :func:`models.trim.trim`'s
+    engine handling): the DHC6, or an XML whose engine files are ``<turboprop_engine>``."""
+    if not is_xml_model(model):
+        return model in TURBOPROP_MODELS
+    source = model_xml(model)
+    prop = ET.parse(source).getroot().find("propulsion")
+    engines = engine_root(source) / "engine"
+    for el in (prop.findall("engine") if prop is not None else []):
+        path = engines / f"{el.get('file', '')}.xml"
+        if path.is_file() and ET.parse(path).getroot().tag == "turboprop_engine":
+            return True
+    return False
+
+
+def missing_files(model: str) -> list[str]:
+    """The engine, thruster and system files an aircraft XML given by path names but JSBSim
+    would not find (engines in ``<root>/engine``, beside the XML or in its ``Engines/``;
+    systems beside it, in its ``Systems/`` or in ``<root>/systems``)."""
+    source = model_xml(model)
+    root = ET.parse(source).getroot()
+    engines = engine_root(source)
+    missing = []
+    for el in root.iter():
+        name = el.get("file")
+        if not name or el.tag not in ("engine", "thruster", "system"):
+            continue
+        places = ([engines / "engine", source.parent, source.parent / "Engines"] if el.tag != "system"
+                  else [source.parent, source.parent / "Systems", engines / "systems"])
+        files = (name,) if name.endswith(".xml") else (name, f"{name}.xml")
+        if not any((d / f).is_file() for d in places for f in files):
+            missing.append(f"{el.tag} file {name!r} (looked in {', '.join(str(d) for d in places)})")
+    return missing
+
+
+def xml_surface_properties(model: str) -> dict[str, str]:
+    """The surface properties an aircraft XML's aerodynamics read (``SURFACE_CANDIDATES``).
+
+    Raises
+    ------
+    ValueError
+        Naming the surface none of whose candidate properties the aerodynamics read.
+    """
+    aero = ET.parse(model_xml(model)).getroot().find("aerodynamics")
+    read = {(el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar")} \
+        if aero is not None else set()
+    out = {}
+    for s, props in SURFACE_CANDIDATES.items():
+        found = [p for p in props if p in read]
+        if not found:
+            raise ValueError(f"{model}: its aerodynamics read none of {props}, so the {s} input has "
+                             "nowhere to go (the project drives these surface properties directly)")
+        out[s] = found[0]
+    return out
 
 
 def new_fdm(root: Path | None, name: str, dt: float) -> jsbsim.FGFDMExec:
@@ -144,17 +236,25 @@ def nominal_tree(model: str) -> ET.ElementTree:
     """The XML of the nominal model (what :func:`nominal_root` loads), freshly parsed."""
     if model == "dhc6":
         return dhc6_tree()
+    if is_xml_model(model):
+        try:
+            return strip_io(ET.parse(model_xml(model)))
+        except ET.ParseError as exc:
+            raise ValueError(f"{model} is not a readable JSBSim aircraft XML: {exc}") from exc
     return strip_io(aircraft_xml(PACKAGE_NAMES[model]))
 
 
 def nominal_root(model: str) -> tuple[Path | None, str]:
     """Root folder and aircraft name of the nominal model (a stripped copy for the 737, a
-    copy for the DHC6: see :func:`dhc6_tree`)."""
+    copy for the DHC6: see :func:`dhc6_tree`; a copy of an XML given by path, its sibling
+    files and its root's engines linked beside it)."""
     if model == "737":
-        return cached_root("737", strip_io(aircraft_xml("737")), "737"), "737"
-    if model == "dhc6":
-        name = PACKAGE_NAMES["dhc6"]
-        return cached_root(name, dhc6_tree(), name), name
+        return cached_root("737", strip_io(aircraft_xml("737")), model_xml(model)), "737"
+    if is_xml_model(model) and (missing := missing_files(model)):
+        raise ValueError(f"{model} names files JSBSim will not find: {'; '.join(missing)}")
+    if model == "dhc6" or is_xml_model(model):
+        name = PACKAGE_NAMES.get(model) or Path(model).stem
+        return cached_root(name, nominal_tree(model), model_xml(model)), name
     return None, model
 
 
@@ -170,7 +270,7 @@ def load_fdm(aircraft: Aircraft, dt: float, *, root: Path | None = None,
             raise ValueError("the exact-truth variant is built per flight condition: "
                              "use models.exact.exact_truth_root() and pass root= and name=")
         root, name = nominal_root(aircraft.model)
-    fdm = new_fdm(root, name or aircraft.model, dt)
+    fdm = new_fdm(root, name or aircraft.name, dt)
     for e in aircraft.hidden:
         if e.effect == "control_delay":
             from models.hidden import delay_property

@@ -18,9 +18,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from models.aircraft import Aircraft, nominal_root
+from models.aircraft import Aircraft, model_xml, nominal_tree
 from models.conditions import FlightCondition
-from models.jsbsim_root import aircraft_xml, cached_root, strip_io, write_root
+from models.jsbsim_root import cached_root, write_root
 from models.truth import LATERAL_VARIABLES, LONGITUDINAL_VARIABLES, Derivatives, truth_derivatives
 
 # Axis -> (coefficient, reference length property or None, variables)
@@ -84,9 +84,7 @@ def exact_truth_tree(aircraft: Aircraft, condition: FlightCondition) -> tuple[ET
     truth it was built from."""
     nominal = Aircraft(aircraft.model, "nominal")
     truth = truth_derivatives(nominal, condition)
-    base_root, base_name = nominal_root(aircraft.model)
-    tree = (strip_io(aircraft_xml(aircraft.model)) if base_root is None
-            else ET.parse(base_root / "aircraft" / base_name / f"{base_name}.xml"))
+    tree = nominal_tree(aircraft.model)
     root = tree.getroot()
     old = root.find("aerodynamics")
     index = list(root).index(old)
@@ -109,7 +107,7 @@ def exact_truth_root(aircraft: Aircraft, condition: FlightCondition,
     cache folder keyed by the XML's content.
     """
     tree, _ = exact_truth_tree(aircraft, condition)
-    name = f"{aircraft.model}-exact"
+    name = f"{aircraft.name}-exact"
     if dest is not None:
-        return write_root(Path(dest), name, tree, aircraft.model), name
-    return cached_root(name, tree, aircraft.model), name
+        return write_root(Path(dest), name, tree, model_xml(aircraft.model)), name
+    return cached_root(name, tree, model_xml(aircraft.model)), name

@@ -298,16 +298,14 @@ def hidden_root(aircraft, condition, refs: dict[str, float] | None = None):
     ``condition`` unless ``refs`` or an effect's ``reference`` gives them, so an added
     α-polynomial vanishes, with its slope, at the trim point.
     """
-    from models.aircraft import Aircraft, load_fdm, nominal_root
-    from models.jsbsim_root import aircraft_xml, cached_root, strip_io
+    from models.aircraft import Aircraft, load_fdm, model_xml, nominal_tree
+    from models.jsbsim_root import cached_root
     from models.trim import trim
     nominal = Aircraft(aircraft.model, "nominal")
     tp = trim(load_fdm(nominal, 1 / 120), nominal, condition)
     base = {"alpha": tp.alpha_rad, "dV": tp.V_fps, "de": tp.de_rad, "da": tp.da_rad, "dr": tp.dr_rad}
     base.update(refs or {})
-    base_root, base_name = nominal_root(aircraft.model)
-    tree = (strip_io(aircraft_xml(aircraft.model)) if base_root is None
-            else ET.parse(base_root / "aircraft" / base_name / f"{base_name}.xml"))
+    tree = nominal_tree(aircraft.model)
     add_hidden_aerodynamics(tree, tuple(aircraft.hidden), base["alpha"], nominal.surfaces, base)
-    name = f"{aircraft.model}-hidden"
-    return cached_root(name, tree, aircraft.model), name
+    name = f"{aircraft.name}-hidden"
+    return cached_root(name, tree, model_xml(aircraft.model)), name

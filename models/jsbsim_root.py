@@ -43,20 +43,33 @@ def _link(src: Path, dst: Path) -> None:
         dst.symlink_to(src, target_is_directory=src.is_dir())
 
 
-def write_root(dest: Path, name: str, tree: ET.ElementTree, based_on: str) -> Path:
+def engine_root(source: Path) -> Path:
+    """The JSBSim root whose ``engine/`` and ``systems/`` an aircraft XML at ``source`` uses:
+    its own root when it sits in one (``<root>/aircraft/<name>/<name>.xml`` beside
+    ``<root>/engine``), otherwise the package's."""
+    own = source.parent.parent.parent
+    if source.parent.parent.name == "aircraft" and (own / "engine").is_dir():
+        return own
+    return package_root()
+
+
+def write_root(dest: Path, name: str, tree: ET.ElementTree, source: Path) -> Path:
     """Write ``tree`` as aircraft ``name`` into JSBSim root ``dest`` and return ``dest``.
 
-    The aircraft's sibling files (``Systems/``, init files) of the package's ``based_on``
-    aircraft are linked beside it, and ``engine/`` and ``systems/`` at the root. The XML is
-    written to a temporary file and renamed, so a reader never sees half of it.
+    ``source`` is the aircraft XML the tree was made from: its sibling files (``Systems/``,
+    init files) are linked beside the copy, and ``engine/`` and ``systems/`` of its root
+    (:func:`engine_root`) at the root. The XML is written to a temporary file and renamed,
+    so a reader never sees half of it.
     """
-    pkg = package_root()
+    source = Path(source)
     craft_dir = dest / "aircraft" / name
     craft_dir.mkdir(parents=True, exist_ok=True)
+    engines = engine_root(source)
     for sub in ("engine", "systems"):
-        _link(pkg / sub, dest / sub)
-    for item in (pkg / "aircraft" / based_on).iterdir():
-        if item.name != f"{based_on}.xml":
+        if (engines / sub).exists():
+            _link(engines / sub, dest / sub)
+    for item in source.parent.iterdir():
+        if item.name not in (source.name, f"{name}.xml") and not item.name.endswith(".tmp"):
             _link(item, craft_dir / item.name)
     target = craft_dir / f"{name}.xml"
     fd, tmp = tempfile.mkstemp(dir=craft_dir, suffix=".xml.tmp")
@@ -66,15 +79,16 @@ def write_root(dest: Path, name: str, tree: ET.ElementTree, based_on: str) -> Pa
     return dest
 
 
-def cached_root(name: str, tree: ET.ElementTree, based_on: str) -> Path:
-    """A root for ``tree`` in the system temp folder, keyed by the XML's content hash.
+def cached_root(name: str, tree: ET.ElementTree, source: Path) -> Path:
+    """A root for ``tree`` (made from the aircraft XML ``source``) in the system temp
+    folder, keyed by the XML's content hash.
 
     The same aircraft text always maps to the same folder, so processes share it and a
     second call costs nothing; nothing is held in memory between calls.
     """
     text = ET.tostring(tree.getroot())
-    digest = hashlib.sha256(text + name.encode() + based_on.encode()).hexdigest()[:16]
+    digest = hashlib.sha256(text + name.encode() + str(Path(source).resolve()).encode()).hexdigest()[:16]
     dest = Path(tempfile.gettempdir()) / "sidbench-aircraft" / f"{name}-{digest}"
     if not (dest / "aircraft" / name / f"{name}.xml").is_file():
-        write_root(dest, name, tree, based_on)
+        write_root(dest, name, tree, source)
     return dest

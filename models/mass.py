@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from models.aircraft import PACKAGE_NAMES, nominal_tree
+from models.aircraft import PACKAGE_NAMES, is_xml_model, model_xml, nominal_tree
 from models.jsbsim_root import cached_root
 
 # JSBSim's own conversion (FGJSBBase::slugtolb): weight in lbs = mass in slug * 32.174049.
@@ -169,9 +169,8 @@ def mass_root(model: str, mass: MassProperties, *,
     trim with :func:`models.trim.trim` as usual. The folder is keyed by the XML's content, so
     each loading gets its own and repeated calls cost only the XML rewrite.
     """
-    if model not in PACKAGE_NAMES:
-        raise ValueError(f"unknown aircraft {model!r}; choose one of {tuple(PACKAGE_NAMES)}")
+    if model not in PACKAGE_NAMES and not is_xml_model(model):
+        raise ValueError(f"unknown aircraft {model!r}; choose one of {tuple(PACKAGE_NAMES)} or an XML path")
     tree = set_mass_properties(nominal_tree(model), mass, cg_in=cg_in)
-    based_on = PACKAGE_NAMES[model]
-    name = f"{based_on}-mass"
-    return cached_root(name, tree, based_on), name
+    name = f"{PACKAGE_NAMES.get(model) or Path(model).stem}-mass"
+    return cached_root(name, tree, model_xml(model)), name

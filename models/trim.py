@@ -5,7 +5,7 @@ from dataclasses import asdict, dataclass
 
 import jsbsim
 
-from models.aircraft import TRIM_MOMENT_PROPERTIES, TURBOPROP_MODELS, Aircraft, place_reference_point
+from models.aircraft import TRIM_MOMENT_PROPERTIES, Aircraft, is_turboprop, place_reference_point
 from models.conditions import FlightCondition
 
 G0_FPS2 = 32.17404855643  # standard gravity, ft/s^2 (9.80665 m/s^2)
@@ -100,7 +100,7 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     follows. The aircraft's reference-point rule is applied before trimming. Fuel is frozen
     afterwards so mass and c.g. stay put.
 
-    Turboprops (``TURBOPROP_MODELS``: the DHC6) deliver no shaft power while JSBSim trims,
+    Turboprops (:func:`models.aircraft.is_turboprop`: the DHC6) deliver no shaft power while JSBSim trims,
     so they are re-trimmed with their propeller torque applied as external moments
     (:func:`_trim_with_propeller_torque`) and their engines left running at steady state
     (:func:`settle_engines`): flown from here, the first frame is in equilibrium.
@@ -116,14 +116,16 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     fdm.run_ic()
     if place_reference_point(fdm, aircraft):
         fdm.run_ic()
-    turboprop = aircraft.model in TURBOPROP_MODELS
+    turboprop = is_turboprop(aircraft.model)
+    # The propeller-torque re-trim needs the stand-in moments (the DHC6 copy has them).
+    torque = turboprop and fdm.get_property_manager().hasNode(next(iter(TRIM_MOMENT_PROPERTIES.values())))
     try:
         fdm.do_trim(0)
         lateral = max(abs(fdm["accelerations/pdot-rad_sec2"]), abs(fdm["accelerations/rdot-rad_sec2"]),
                       abs(fdm["accelerations/vdot-ft_sec2"]))
         if lateral > 1e-6:
             fdm.do_trim(1)
-        if turboprop:
+        if torque:
             _trim_with_propeller_torque(fdm)
     except jsbsim.TrimFailureError as exc:
         hint = ""

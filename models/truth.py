@@ -20,13 +20,14 @@ import math
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import jsbsim
 import numpy as np
 
-from models.aircraft import Aircraft, load_fdm, nominal_root
+from models.aircraft import Aircraft, load_fdm, model_xml, nominal_tree
 from models.conditions import FlightCondition
-from models.jsbsim_root import aircraft_xml, cached_root, strip_io
+from models.jsbsim_root import cached_root
 from models.trim import TrimPoint, trim
 
 LONGITUDINAL_COEFFICIENTS = ("CL", "CD", "CX", "CZ", "Cm")
@@ -236,17 +237,14 @@ def differencing_instance(aircraft: Aircraft, condition: FlightCondition, *,
                           root=None, name=None, dt: float = 1 / 120) -> tuple[jsbsim.FGFDMExec, TrimPoint, bool]:
     """A trimmed instance of ``aircraft`` whose α̇/β̇ aerodynamic terms are gated (if any)."""
     if root is None:
-        base_root, base_name = nominal_root(aircraft.model)
-        tree = strip_io(aircraft_xml(aircraft.model)) if base_root is None else \
-            ET.parse(base_root / "aircraft" / base_name / f"{base_name}.xml")
-        based_on = aircraft.model
+        tree, source = nominal_tree(aircraft.model), model_xml(aircraft.model)
     else:
-        tree = ET.parse(root / "aircraft" / name / f"{name}.xml")
-        based_on = aircraft.model
+        source = Path(root) / "aircraft" / name / f"{name}.xml"
+        tree = ET.parse(source)
     tree, gated = gate_unsteady_terms(tree)
     if gated or root is not None:
-        groot = cached_root(f"{name or aircraft.model}-diff", tree, based_on)
-        fdm = load_fdm(aircraft, dt, root=groot, name=f"{name or aircraft.model}-diff")
+        groot = cached_root(f"{name or aircraft.name}-diff", tree, source)
+        fdm = load_fdm(aircraft, dt, root=groot, name=f"{name or aircraft.name}-diff")
     else:
         fdm = load_fdm(aircraft, dt)
     if gated:

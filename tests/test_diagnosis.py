@@ -75,8 +75,52 @@ def test_augmented_model_is_written(gallery):
 
 
 def test_unknown_model_is_refused(tmp_path):
-    with pytest.raises(DiagnosisError, match="not one of the project's models"):
+    with pytest.raises(DiagnosisError, match="neither one of the project's models"):
         diagnose("gremlin", tmp_path / "x.csv", tmp_path / "out")
+
+
+def test_model_given_as_a_jsbsim_xml_path_diagnoses_like_the_named_model(gallery, tmp_path):
+    """An aircraft copied with its folder (XML + Systems/) to a place outside any JSBSim
+    root flies like the package's own: the same finding to the last digit."""
+    import shutil
+
+    from models.jsbsim_root import package_root
+    src = package_root() / "aircraft" / "f16"
+    shutil.copytree(src / "Systems", tmp_path / "jet" / "Systems")
+    shutil.copy(src / "f16.xml", tmp_path / "jet" / "myjet.xml")
+    rec = tmp_path / "rec"
+    paths = write_case(case("unsteady_alphadot"), rec, seed=1)
+    r = diagnose(str(tmp_path / "jet" / "myjet.xml"), paths["identification"], tmp_path / "out")
+    ref = gallery["unsteady_alphadot"]["findings"][0]
+    assert r["findings"][0]["parameter"] == ref["parameter"]
+    assert r["findings"][0]["estimate"] == pytest.approx(ref["estimate"], rel=1e-9)
+    assert (tmp_path / "out" / r["model"]["augmented_xml"]).name == "myjet-diagnosed.xml"
+
+
+def test_xml_model_errors_name_the_cause(tmp_path):
+    from models.jsbsim_root import package_root
+    (tmp_path / "bad.xml").write_text("<fdm_config")
+    with pytest.raises(DiagnosisError, match="bad.xml"):
+        diagnose(str(tmp_path / "bad.xml"), tmp_path / "x.csv", tmp_path / "out")
+    with pytest.raises(DiagnosisError, match="no JSBSim aircraft file"):
+        diagnose(str(tmp_path / "absent.xml"), tmp_path / "x.csv", tmp_path / "out")
+    # the F-16 XML without its Systems/ folder: the missing system file is named
+    (tmp_path / "lone.xml").write_bytes((package_root() / "aircraft" / "f16" / "f16.xml").read_bytes())
+    with pytest.raises(DiagnosisError, match="system file 'pushback'"):
+        diagnose(str(tmp_path / "lone.xml"), tmp_path / "x.csv", tmp_path / "out")
+
+
+def test_xml_model_surfaces_are_found_in_its_aerodynamics():
+    """The C172x's aerodynamics read fcs/effective-aileron-pos (half the differential), and
+    it trims from its path like any project model."""
+    from models.aircraft import Aircraft
+    from models.jsbsim_root import package_root
+    from models.replay import InitialCondition, trim_at
+    a = Aircraft(str(package_root() / "aircraft" / "c172x" / "c172x.xml"))
+    assert a.surfaces == {"de": "fcs/elevator-pos-rad", "da": "fcs/effective-aileron-pos",
+                          "dr": "fcs/rudder-pos-rad"}
+    tp = trim_at(a, InitialCondition(4000.0, 180.0))
+    assert tp.V_fps == pytest.approx(180.0, abs=0.5) and 0.0 < tp.alpha_rad < 0.1
 
 
 # -- pieces against analytic truth -----------------------------------------------------------

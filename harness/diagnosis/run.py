@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import shutil
 import time
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
 from harness.recording_io import read_recording
-from models.aircraft import MODELS, Aircraft
+from models.aircraft import MODELS, Aircraft, is_xml_model, nominal_root
 from models.hidden import HiddenEffect, hidden_root
 from models.replay import initial_condition, replay
 
@@ -56,10 +57,19 @@ class DiagnosisError(RuntimeError):
 
 
 def _aircraft(model: str) -> Aircraft:
+    """A project model by name, or a JSBSim aircraft XML by path (flown as it is)."""
     if model in MODELS:
         return Aircraft(model)
-    raise DiagnosisError(f"--model {model!r} is not one of the project's models {MODELS}; "
-                         "a JSBSim XML path is not supported yet (see the README's limits)")
+    if not is_xml_model(model):
+        raise DiagnosisError(f"--model {model!r} is neither one of the project's models {MODELS} "
+                             "nor the path of a JSBSim aircraft XML (<name>.xml)")
+    try:
+        aircraft = Aircraft(str(Path(model).resolve()))
+        aircraft.surfaces  # noqa: B018 - fails early, naming a surface the XML lacks
+        nominal_root(aircraft.model)  # and a file its engines or systems need
+    except (ValueError, OSError, ET.ParseError) as exc:
+        raise DiagnosisError(f"--model {model}: {exc}") from exc
+    return aircraft
 
 
 def _effect_of(c: Candidate) -> HiddenEffect | None:
@@ -287,7 +297,7 @@ def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, .
                 "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
     root, name = hidden_root(Aircraft(aircraft.model, hidden=added), ic.condition())
     src = root / "aircraft" / name / f"{name}.xml"
-    target = dest / f"{aircraft.model}-diagnosed.xml"
+    target = dest / f"{aircraft.name}-diagnosed.xml"
     write_atomic(target, lambda fh: fh.write(src.read_bytes()))
     return {"base": aircraft.model, "augmented_xml": str(target.relative_to(out)), "terms": terms,
             "note": ("a control delay is a property (sidbench/<surface>-delay-delta-rad) the sidbench flight loop "
