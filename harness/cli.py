@@ -117,7 +117,11 @@ def _parser() -> argparse.ArgumentParser:
                                    "surfaces from trim, locate the mismatch, test every effect of effects.md, add "
                                    "the significant ones to the model and fly it again. Writes OUT/findings.json, "
                                    "OUT/report.html, OUT/series/*.parquet and OUT/model/ (the augmented aircraft).")
-    g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6)")
+    g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6), or the path of a "
+                                                   "JSBSim aircraft XML")
+    g.add_argument("--mass", choices=("model", "recording"), default="model",
+                   help="fly the model with its own mass properties (default) or with the recording's (mass, "
+                        "inertia at its first sample)")
     g.add_argument("--recording", required=True, help="identification recording (.csv beside .meta.json, or .parquet)")
     g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
     g.add_argument("--out", required=True, help="output folder")

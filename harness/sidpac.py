@@ -15,6 +15,10 @@ Mapping
   ``el`` -> ``de``, ``ail`` -> ``da``, ``rdr`` -> ``dr``, ``qbar``, ``mach``,
   ``alt`` -> ``h``, ``thrust``, ``pdot``/``qdot``/``rdot``) become canonical
   channels (angles converted to rad, rates to rad/s).
+* ``ail`` changes sign: the format uses JSBSim's surface signs (a positive aileron rolls
+  the aircraft right, C_l,δa > 0 in the F-16, 737 and DHC6 models), while in SIDPAC's
+  files a positive ``ail`` rolls it left (both Twin Otter files give C_l,δa ≈ −0.21 by
+  equation error with the file's sign). The flip is written to ``meta['import_notes']``.
 * ``mass``, ``Ixx``, ``Iyy``, ``Izz``, ``Ixz``: constant -> scalar in
   ``meta['mass']``; varying -> channel (``mass_slug``, ``Ix_slugft2``, ...).
 * ``xcg``/``ycg``/``zcg`` (in) -> ``meta['sidpac']['cg_in']``.
@@ -85,6 +89,8 @@ _LABEL_TO_QUANTITY: dict[str, str] = {
     # Eqs. 3-5 (the format's convention), so the value is copied as is.
     "mass": "mass", "Ixx": "Ix", "Iyy": "Iy", "Izz": "Iz", "Ixz": "Ixz",
 }
+# Sign changes from SIDPAC's surface conventions to the format's (JSBSim's): see the docstring.
+_SIGN_TO_FORMAT: dict[str, float] = {"ail": -1.0}
 _MASS_QUANTITIES = ("mass", "Ix", "Iy", "Iz", "Ixz")
 _CG_LABELS = ("xcg", "ycg", "zcg")
 _GEOMETRY_FIELDS = {"sarea": "S_ft2", "bspan": "b_ft", "cbar": "cbar_ft"}
@@ -280,7 +286,11 @@ def import_sidpac(path: str | Path) -> Recording:
                 mass_meta[spec.column] = float(values[0]) * spec.units[fmt_unit]
                 provenance[f"meta.mass.{spec.column}"] = number
                 continue
-            channels[name] = values
+            sign = _SIGN_TO_FORMAT.get(label, 1.0)
+            if sign != 1.0:
+                notes.append(f"{quantity} is {where} negated: SIDPAC's positive {label} rolls the aircraft left, the "
+                             "format's (JSBSim's) rolls it right.")
+            channels[name] = sign * values
             provenance[spec.column] = number
             continue
         # An extra channel: keep it in canonical units when the unit is known.
@@ -369,7 +379,8 @@ def import_sidpac(path: str | Path) -> Recording:
                  "the measured ones are kept as axm_g/aym_g/azm_g when present.")
     notes.append("thrust_offset_ft is not in the file; set to 0.0, i.e. any thrust moment stays in the "
                  "moment coefficients, as in SIDPAC's own Cl/Cm/Cn columns.")
-    notes.append("control-surface signs copied from SIDPAC unchanged (not checked against JSBSim's).")
+    notes.append("elevator and rudder signs copied from SIDPAC unchanged: they agree with JSBSim's (trailing edge "
+                 "down, and trailing edge left, positive: the Twin Otter's C_n,δr < 0 as in JSBSim's models).")
     notes.append("Ixz copied unchanged: SIDPAC uses the seed's (Eqs. 3-5) sign convention.")
 
     meta: dict[str, Any] = {

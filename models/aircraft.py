@@ -126,11 +126,14 @@ def is_turboprop(model: str) -> bool:
         return model in TURBOPROP_MODELS
     source = model_xml(model)
     prop = ET.parse(source).getroot().find("propulsion")
-    engines = engine_root(source) / "engine"
+    places = (engine_root(source) / "engine", source.parent, source.parent / "Engines")
     for el in (prop.findall("engine") if prop is not None else []):
-        path = engines / f"{el.get('file', '')}.xml"
-        if path.is_file() and ET.parse(path).getroot().tag == "turboprop_engine":
-            return True
+        for d in places:
+            path = d / f"{el.get('file', '')}.xml"
+            if path.is_file():
+                if ET.parse(path).getroot().tag == "turboprop_engine":
+                    return True
+                break
     return False
 
 

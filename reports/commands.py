@@ -76,7 +76,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     """Run the discrepancy diagnosis and write its report."""
     from harness.diagnosis.run import diagnose
     from reports.diagnosis_report import write_diagnosis_report
-    result = diagnose(args.model, args.recording, args.out, args.validation)
+    result = diagnose(args.model, args.recording, args.out, args.validation, mass=args.mass)
     html = write_diagnosis_report(Path(args.out))
     for f in result["findings"]:
         if f["effect"] == "none":

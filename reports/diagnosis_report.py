@@ -339,11 +339,15 @@ def findings_table(findings: Sequence[Mapping]) -> Table:
     rows = [{"effect": str(f.get("effect", "")), "axis / channel": _where(f),
              "parameter": _scalar(f.get("parameter")), "estimate": _num(f.get("estimate")),
              "std_error": _num(f.get("std_error")), "t": _num(_dict(f.get("evidence")).get("t")),
-             "units": _scalar(f.get("units")), "explanation": _scalar(f.get("explanation"))}
+             "units": _scalar(f.get("units")),
+             "on validation": _dict(_dict(f.get("evidence")).get("validation")).get("status", "—"),
+             "explanation": _scalar(f.get("explanation"))}
             for f in findings]
     return Table("Findings", pd.DataFrame(rows),
                  "Most significant first. std_error is the estimate's standard error, t = estimate / "
-                 "std_error from the selecting test.")
+                 "std_error from the selecting test. 'on validation': what the term, at its estimated size, does "
+                 "to the validation maneuver's coefficient mismatch (confirmed: drops by 1 % or more; "
+                 "contradicted: grows, and the term is left out of the augmented model).")
 
 
 def evidence_table(findings: Sequence[Mapping]) -> Table | None:
@@ -597,6 +601,9 @@ def before_after_section(data: Mapping, series: Mapping[str, pd.DataFrame], mane
     lines = ("The maneuver the added terms were estimated from: a better fit here is expected, the "
              "validation maneuver is the test." if maneuver == "identification" else
              "A maneuver the estimate never saw: the augmented model must fit it better without refitting.",)
+    failed = _dict(after.get(maneuver)).get("replay_failed")
+    if failed:
+        lines += (f"{failed}. The output fit after the change is therefore not shown; the coefficient fit is.",)
     if table is None and not figures:
         lines += ("No fit numbers or series were written for this maneuver.",)
     return Section(f"Before and after: {maneuver}", lines, _figs(table), figures)

@@ -86,6 +86,9 @@ def test_twin_otter_017(imported: dict) -> None:
     assert np.array_equal(rec.channel("CY"), fdata[:, 61])
     assert np.array_equal(rec.channel("ay"), fdata[:, 11])  # c.g.-referenced, not column 54
     assert np.array_equal(rec.channel("qbar"), fdata[:, 26])
+    da_col = rec.meta["sidpac"]["columns"]["da_rad"] - 1
+    assert np.array_equal(rec.channel("da"), -fdata[:, da_col] * DEG)  # JSBSim's aileron sign
+    assert any("negated" in n for n in rec.meta["import_notes"])
     assert abs(rec.channel("beta")).max() < 0.3
     assert rec.channel("beta").min() == pytest.approx(-6.77374 * DEG, rel=1e-5)
     # Constant inertias in meta, varying mass properties as channels.

@@ -101,7 +101,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         states["h"] = p.smooth["h"]
     aero = aero_along(aircraft, ic, states, {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth},
                       p.deriv["alpha"])
-    measured = measured_coefficients(p.smooth, p.deriv, p.meta, aero.trim.thrust_lbf)
+    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, aero.trim.thrust_lbf)
     mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches

@@ -153,7 +153,7 @@ def accelerometer_columns(p: Prepared) -> dict[str, dict[str, np.ndarray]]:
     """ΔCX, ΔCY, ΔCZ per ft of accelerometer x, y, z position (the coefficient error a
     sensor at r makes: m[ω̇ × r + ω × (ω × r)]/(q̄S))."""
     s, d = p.smooth, p.deriv
-    m, S = p.meta["mass"]["mass_slug"], p.meta["geometry"]["S_ft2"]
+    m, S = float(np.mean(p.mass["mass_slug"])), p.meta["geometry"]["S_ft2"]
     w = np.stack([s["p"], s["q"], s["r"]], axis=-1)
     wd = np.stack([d["p"], d["q"], d["r"]], axis=-1)
     out = {}

@@ -35,6 +35,7 @@ class Prepared:
     measured : coefficients (Eqs. 1-5) from the filtered channels.
     start : the recording's initial values (means over the first 0.5 s of ``smooth``).
     meta : the recording's metadata.
+    mass : mass and inertia per sample (``Recording.mass_at``: metadata constants or channels).
     own_noise : each channel minus its own optimal smoothing (what the smoother calls noise).
     """
 
@@ -53,6 +54,7 @@ class Prepared:
     start: dict[str, float]
     meta: dict = field(default_factory=dict)
     own_noise: dict[str, np.ndarray] = field(default_factory=dict)  # raw − each channel's own optimal smoothing
+    mass: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n(self) -> int:
@@ -113,21 +115,25 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     k = max(1, int(round(START_WINDOW_S / dt)))
     start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
     cutoff = float(np.max(np.nonzero(w > 1e-6)[0], initial=0) + 1) / (2.0 * t[-1])
-    measured = measured_coefficients(smooth, deriv, rec.meta)
+    try:
+        mass = {k: np.asarray(v, dtype=float) for k, v in rec.mass_at().items()}
+    except (KeyError, ValueError) as exc:
+        raise ValueError(f"recording {rec.name!r} lacks mass properties Eqs. 1-5 need: {exc}") from exc
+    measured = measured_coefficients(smooth, deriv, rec.meta, mass)
     return Prepared(name=name, t=t, dt=dt, raw=raw, smooth=smooth, deriv=deriv, noise_std=noise,
                     cutoff_hz={c: f.cutoff_hz for c, f in fits.items()}, weights=w, common_cutoff_hz=cutoff,
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
-                    own_noise={c: np.asarray(f.noise) for c, f in fits.items()})
+                    own_noise={c: np.asarray(f.noise) for c, f in fits.items()}, mass=mass)
 
 
 def measured_coefficients(s: dict[str, np.ndarray], d: dict[str, np.ndarray], meta: dict,
-                          thrust_lbf: float | None = None) -> dict[str, np.ndarray]:
+                          mass: dict[str, np.ndarray], thrust_lbf: float | None = None) -> dict[str, np.ndarray]:
     """Seed Eqs. 1 and 3-5 from filtered channels ``s`` and their derivatives ``d``.
 
     Thrust is the recorded channel when present, else ``thrust_lbf`` (the model's trim
     thrust), else zero; the accelerometer is moved to the c.g. when the metadata place it
     elsewhere."""
-    geo, mass = meta["geometry"], meta["mass"]
+    geo = meta["geometry"]
     p, q, r = s["p"], s["q"], s["r"]
     pd_, qd, rd = d["p"], d["q"], d["r"]
     ax, ay, az = accelerometer_at_cg(s["ax"], s["ay"], s["az"], p, q, r, pd_, qd, rd,

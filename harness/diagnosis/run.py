@@ -19,7 +19,10 @@ from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
 from harness.recording_io import read_recording
 from models.aircraft import MODELS, Aircraft, is_xml_model, nominal_root
 from models.hidden import HiddenEffect, hidden_root
+from models.flight import FlightError
+from models.mass import MassProperties, mass_root
 from models.replay import initial_condition, replay
+from models.trim import TrimError
 
 SURFACES = ("de", "da", "dr")
 _CHANNEL_COLUMNS = {"alpha": "alpha_rad", "beta": "beta_rad", "p": "p_rps", "q": "q_rps", "r": "r_rps",
@@ -89,7 +92,10 @@ def _effect_of(c: Candidate) -> HiddenEffect | None:
     if e == "control_delay":
         return HiddenEffect(e, max(c.estimate, 0.0), surface=c.channel)
     if e == "sensor_offset" and c.channel == "accelerometer":
-        pos = tuple(float(v) for v in c.details["position_ft"])
+        if "position_ft" in c.details:  # the force-mismatch fit: the whole vector
+            pos = tuple(float(v) for v in c.details["position_ft"])
+        else:  # the kinematic check: one component (offset_x, offset_y, offset_z)
+            pos = tuple(float(c.estimate) if c.parameter == f"offset_{a}" else 0.0 for a in "xyz")
         return HiddenEffect(e, pos[0], position_ft=pos)
     if e in ("sensor_bias", "sensor_scale", "sensor_time_skew") and c.channel in _CHANNEL_COLUMNS:
         return HiddenEffect(e, c.estimate, channel=c.channel)
@@ -135,27 +141,60 @@ def _after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, n
     return after, n_terms
 
 
+def _inner(p: Prepared) -> slice:
+    k = max(1, int(round(1.0 / p.dt)))
+    return slice(k, p.n - k)
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean((x - x.mean()) ** 2)))
+
+
+def validation_check(av: Analysis, f: Candidate) -> dict | None:
+    """What one identification finding, with its size as estimated, does to the validation
+    maneuver's coefficient mismatch on its axes (a prediction: nothing is refitted).
+
+    ``status`` is 'confirmed' (the mismatch RMS drops by 1 % or more), 'contradicted' (it
+    rises by 1 % or more) or 'neutral'; None for a finding with no coefficient term (a
+    sensor effect, a gust level, a spectral peak)."""
+    after, n_terms = _after_mismatch(av, [f])
+    axes = [c for c in COEFFICIENTS if n_terms[c]]
+    if not axes:
+        return None
+    inner = _inner(av.prepared)
+    before_rms = {c: _rms(av.mismatch[c][inner]) for c in axes}
+    after_rms = {c: _rms(after[c][inner]) for c in axes}
+    ratio = sum(after_rms.values()) / max(sum(before_rms.values()), 1e-300)
+    status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
+    return {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms,
+            "change": ratio - 1.0}
+
+
 def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
-              findings: list[Candidate] | None, ident: Analysis | None):
-    """Replays before/after and fits for one maneuver. With ``ident`` given this is the
-    identification maneuver (already analysed); otherwise it is analysed here for its
-    mismatch, and the identification's findings are applied as predictions."""
-    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
+              findings: list[Candidate] | None, analysis: Analysis):
+    """Replays before/after and fits for one analysed maneuver; on the validation maneuver
+    the identification's findings are applied as predictions."""
+    ic = analysis.ic
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     before_hist, _ = replay(aircraft, ic, p.t, surfaces)
-    after_hist = before_hist
+    after_hist, diverged = before_hist, None
     if added:
-        after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), ic, p.t, surfaces)
-    a = ident if ident is not None else analyse(p, aircraft, ic)
+        try:
+            after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), ic, p.t, surfaces)
+        except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient fits still stand
+            after_hist, diverged = None, str(exc)
+    a = analysis
     before_mm = a.mismatch
     after_mm, n_terms = _after_mismatch(a, findings or [])
-    k = max(1, int(round(1.0 / p.dt)))
-    inner = slice(k, p.n - k)
-    sim_b, sim_a = _sim_channels(before_hist), _sim_channels(after_hist)
+    inner = _inner(p)
+    sim_b = _sim_channels(before_hist)
+    sim_a = _sim_channels(after_hist) if after_hist is not None else {c: np.full(p.n, np.nan) for c in sim_b}
     fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner),
              "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
-    fit_a = {"outputs": output_fit(p.smooth, p.raw, sim_a, OUTPUTS, inner),
+    fit_a = {"outputs": output_fit(p.smooth, p.raw, sim_a, OUTPUTS, inner) if diverged is None else {},
              "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
+    if diverged is not None:
+        fit_a["replay_failed"] = f"the augmented model could not replay this maneuver: {diverged}"
     series = {"t_s": p.t}
     for c in OUTPUTS:
         if c in p.raw:
@@ -203,7 +242,17 @@ def _located(a: Analysis, fit_b: dict, name: str) -> dict:
                         f"model ({outs[worst_out]['ratio']:.1f} times its noise)." if worst_out else "")}
 
 
-def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict) -> dict:
+def _remaining(a: Analysis, fit_b: dict, fit_a: dict) -> dict:
+    """Per axis, the coefficient mismatch left after the findings' terms: RMS over the noise
+    level, and the share of the mismatch RMS the terms removed."""
+    out = {}
+    for c in COEFFICIENTS:
+        before, after = fit_b["coefficients"][c]["rms"], fit_a["coefficients"][c]["rms"]
+        out[c] = {"rms": after, "ratio": after / a.noise[c], "removed": 1.0 - after / before if before > 0 else 0.0}
+    return out
+
+
+def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = None) -> dict:
     fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
            "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
     if c.effect == "coefficient_error":
@@ -214,6 +263,11 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict) -> dict:
         text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
+    if check is not None:
+        evidence["validation"] = check
+        if check["status"] == "contradicted":
+            text += (f" The validation maneuver contradicts it (its {', '.join(check['axes'])} mismatch grows by "
+                     f"{100 * check['change']:.0f} % with the term), so it is not in the augmented model.")
     return {"effect": c.effect, "axis": c.axis if c.axis in ("pitch", "roll", "yaw", "lon", "lat") else None,
             "channel": c.channel, "parameter": c.parameter, "estimate": float(c.estimate),
             "std_error": float(c.std_error), "units": c.units, "evidence": evidence,
@@ -233,8 +287,22 @@ def _none_finding(a: Analysis, fits_b: dict) -> dict:
                            "mismatch is explained by measurement noise alone."}
 
 
-def diagnose(model: str, recording: str | Path, out: str | Path, validation: str | Path | None = None) -> dict:
+def _with_recorded_mass(aircraft: Aircraft, rec) -> Aircraft:
+    """The aircraft with the recording's mass and inertia (its first sample), as an XML copy."""
+    try:
+        mp = MassProperties.from_mapping(rec.mass_at(0))
+        root, name = mass_root(aircraft.model, mp)
+    except (KeyError, ValueError) as exc:
+        raise DiagnosisError(f"--mass recording: {exc}") from exc
+    return Aircraft(str(root / "aircraft" / name / f"{name}.xml"))
+
+
+def diagnose(model: str, recording: str | Path, out: str | Path, validation: str | Path | None = None, *,
+             mass: str = "model") -> dict:
     """Diagnose ``recording`` against ``model``; write ``out``; return findings.json's content.
+
+    ``mass='recording'`` flies the model with the recording's mass and inertia
+    (:func:`models.mass.set_mass_properties`) instead of its own.
 
     Raises
     ------
@@ -245,34 +313,55 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
     out = Path(out)
     aircraft = _aircraft(model)
     rec = read_recording(recording)
+    if mass == "recording":
+        aircraft = _with_recorded_mass(aircraft, rec)
+    elif mass != "model":
+        raise DiagnosisError(f"mass must be 'model' or 'recording', not {mass!r}")
     p = prepare(rec, "identification")
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
     a = analyse(p, aircraft, ic)
     findings = _findings(a)
-    added = tuple(e for e in (_effect_of(f) for f in findings) if e is not None)
+    checks: dict[int, dict | None] = {}
+    av = None
+    if validation is not None:
+        pv = prepare(read_recording(validation), "validation")
+        av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.smooth.get("h")))
+        checks = {id(f): validation_check(av, f) for f in findings}
+        # a finding the validation maneuver contradicts is reported but not modelled
+        findings = sorted(findings, key=lambda f: (checks[id(f)] or {}).get("status") == "contradicted")
+    modelled = [f for f in findings if (checks.get(id(f)) or {}).get("status") != "contradicted"]
+    added = tuple(e for e in (_effect_of(f) for f in modelled) if e is not None)
     timing = {"analysis": time.perf_counter() - t0}
     # the recording as prepared (``a.prepared`` carries the sensor corrections; fits are
     # against what was recorded)
-    _, fb_id, fa_id, series_id = _maneuver(p, aircraft, added, findings, a)
+    _, fb_id, fa_id, series_id = _maneuver(p, aircraft, added, modelled, a)
     fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
     series = {"identification": series_id}
     located = _located(a, fb_id, "identification")
-    if validation is not None:
-        vrec = read_recording(validation)
-        av, fb_v, fa_v, series_v = _maneuver(prepare(vrec, "validation"), aircraft, added, findings, None)
+    located["remaining"] = _remaining(a, fb_id, fa_id)
+    if findings:
+        worst = max(located["remaining"], key=lambda c: located["remaining"][c]["ratio"])
+        w = located["remaining"][worst]
+        removed = f"{100 * w['removed']:.0f} % of it removed" if w["removed"] >= 0.005 else "none of it removed"
+        located["summary"] += (f" After the findings, the largest remaining mismatch is in {worst} ({w['ratio']:.1f} "
+                               f"times its noise level, {removed})"
+                               + (": no candidate term explains it." if w["removed"] < 0.2 else "."))
+    if av is not None:
+        av, fb_v, fa_v, series_v = _maneuver(pv, aircraft, added, modelled, av)
         fits_b["validation"], fits_a["validation"] = fb_v, fa_v
         series["validation"] = series_v
         located["outputs"]["validation"] = _located(av, fb_v, "validation")["outputs"]["validation"]
     timing["total"] = time.perf_counter() - t0
     model_info = _write_model(out, aircraft, ic, added)
     result = {
-        "findings": [_finding_dict(f, fits_b, fits_a) for f in findings] or [_none_finding(a, fits_b)],
+        "findings": [_finding_dict(f, fits_b, fits_a, checks.get(id(f))) for f in findings]
+        or [_none_finding(a, fits_b)],
         "located": located,
         "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
         "candidates": [c.as_dict() for c in sorted(a.candidates, key=lambda c: -abs(c.t))],
         "model": model_info,
         "inputs": {"identification": str(recording), "validation": str(validation) if validation else None,
-                   "model": model},
+                   "model": model, "mass": mass},
         "common_filter_cutoff_hz": p.common_cutoff_hz,
         "timing_s": timing,
         "seed": None,
