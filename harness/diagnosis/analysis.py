@@ -73,18 +73,39 @@ def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str,
 
 def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     """Run every test on recording ``p`` against ``aircraft`` (module docstring)."""
-    # 1. sensors first: kinematic consistency says what the instruments did
+    # 0. turbulence first: gusts make air-relative and inertial velocities differ, which
+    # breaks the kinematic consistency the sensor tests rest on
+    gust = gust_estimate(kinematic_residuals(p.raw, p), p,
+                         0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * 32.174)
+    turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
+    # 1. sensors: kinematic consistency says what the instruments did
     kin = kinematic_check(p)
-    sensor_values = {n: kin.selection.params[n] for n in kin.selection.names}
+    sensor_values = {} if turbulent else {n: kin.selection.params[n] for n in kin.forced + kin.selection.names}
     cands: list[Candidate] = []
+    # the forced biases are tested one by one, not picked as the best of many: the
+    # aerodynamic entry t serves, with the practical-size and precision rules
+    t_kin = cand.T_IN
+    for name in kin.forced:  # the nuisance biases: named when significant, practical and precise
+        sp = kin.parameters[name]
+        est, se = kin.selection.params[name], kin.selection.std_errors[name]
+        t = est / se if se > 0 else 0.0
+        practical = is_practical(name, est, p.dt)
+        precise = se <= max(0.5 * _practical_size(name, p.dt), 0.25 * abs(est))
+        sel = abs(t) >= t_kin and practical and precise and not turbulent
+        reason = ("significant, practical and precise" if sel else "below the entry t" if abs(t) < t_kin else
+                  "within the instrument noise budget (practical size)" if not practical else
+                  "poorly determined" if not precise else NOT_IN_TURBULENCE)
+        cands.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
+                               "kinematic consistency (bias always fitted)", sel, reason))
     for term in kin.selection.terms:
         sp = kin.parameters[term.name]
         practical = is_practical(term.name, term.estimate, p.dt)
         precise = term.std_error <= max(0.5 * _practical_size(term.name, p.dt), 0.25 * abs(term.estimate))
-        sel = term.selected and practical and precise
+        sel = term.selected and practical and precise and not turbulent
         reason = ("significant, practical and precise" if sel else
                   "below the entry t" if not term.selected else
-                  "within the instrument noise budget (practical size)" if not practical else "poorly determined")
+                  "within the instrument noise budget (practical size)" if not practical else
+                  "poorly determined" if not precise else NOT_IN_TURBULENCE)
         cands.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
                                sp.units, "kinematic consistency", sel, reason))
     # correct the channels for everything the kinematics found (noise-budget biases too)
@@ -97,8 +118,12 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         p = replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
     # 2. the model along the measured states
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
-    if "h" in p.smooth:
-        states["h"] = p.smooth["h"]
+    # airspeed and altitude are slow: their own optimal smoothing (a far lower cut-off than the
+    # common filter's) keeps their noise out of the model's coefficients (through q̂ = qc̄/2V,
+    # dynamic pressure and Mach-scheduled terms)
+    for k in ("V", "h"):
+        if k in p.smooth and k in p.own_noise:
+            states[k] = p.raw[k] - p.own_noise[k]
     aero = aero_along(aircraft, ic, states, {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth},
                       p.deriv["alpha"])
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, aero.trim.thrust_lbf)
@@ -132,7 +157,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
         sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra)
         selections[axis] = (sel, {t.key: t for t in terms})
-    cands += _aero_candidates(selections, delays)
+    cands += _aero_candidates(selections, delays, p.dt)
     # 6. spectra and gusts
     peak = structural_peak(p)
     if peak is not None:
@@ -142,9 +167,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                                "residual-spectrum peak over its local median", sel,
                                f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else ""),
                                {"amplitude": peak.amplitude}))
-    e = kinematic_residuals(p.raw, p)
-    gust = gust_estimate(e, p, 0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * 32.174)
-    gsel = gust.ratio_to_noise >= 4.0 and max(gust.sigma_w_fps, gust.sigma_v_fps) >= 3.0
+    gsel = turbulent
     cands.append(Candidate("turbulence", None, None, "sigma_gust_fps", max(gust.sigma_w_fps, gust.sigma_v_fps),
                            max(gust.sigma_w_fps, gust.sigma_v_fps) / 4.0, gust.ratio_to_noise, 0.0, "ft/s",
                            "air-relative vs inertial velocity (integrated kinematic residual)", gsel,
@@ -152,6 +175,11 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                            {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}))
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
                     selections=selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak)
+
+
+GUST_RATIO = 4.0     # the integrated kinematic residual over what sensor noise alone gives
+GUST_MIN_FPS = 3.0   # and at least light turbulence's RMS gust
+NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"
 
 
 def _practical_size(name: str, dt: float) -> float:
@@ -165,7 +193,12 @@ def _practical_size(name: str, dt: float) -> float:
     return PRACTICAL["offset_ft"]
 
 
-def _aero_candidates(selections: dict, delays: dict) -> list[Candidate]:
+# The smallest transport delay worth naming, in samples: below it a delay cannot be told from
+# sample timing (JSBSim-flown recordings show about +0.6 sample on every null flight).
+PRACTICAL_DELAY_SAMPLES = 2.0
+
+
+def _aero_candidates(selections: dict, delays: dict, dt: float) -> list[Candidate]:
     out: list[Candidate] = []
     delay_seen: dict[str, list] = {}
     cg_seen: list = []
@@ -190,11 +223,12 @@ def _aero_candidates(selections: dict, delays: dict) -> list[Candidate]:
         # significance from the stepwise entry of the delay column (its coefficient is τ);
         # size and standard error from the scan's linearised fit
         best = max(rows, key=lambda r: abs(r[1].t))[1]
-        sel = any(t.selected for _, t in rows) and scan.tau_s > 0
+        entered = any(t.selected for _, t in rows)
+        sel = entered and scan.tau_s >= PRACTICAL_DELAY_SAMPLES * dt
         gain = max(t.gain for _, t in rows)
         out.append(Candidate("control_delay", "pitch" if s == "de" else ("roll" if s == "da" else "yaw"), s, f"tau_{s}",
                              scan.tau_s, scan.std_error, best.t, gain, "s", f"delay scan of {s} + stepwise", sel,
-                             "entered" if sel else "not entered",
+                             "entered" if sel else ("entered, but under two samples" if entered else "not entered"),
                              {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
     if cg_seen:
         axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))

@@ -34,6 +34,17 @@ DEG = np.pi / 180
 PRACTICAL = {"bias": {"alpha": 0.3 * DEG, "beta": 0.15 * DEG, "V": 3.0, "p": 0.15 * DEG, "q": 0.15 * DEG,
                       "r": 0.15 * DEG, "phi": 1.0 * DEG, "theta": 1.0 * DEG, "ax": 0.015, "ay": 0.015, "az": 0.015},
              "scale": 0.02, "skew_samples": 2.0, "offset_ft": 1.5}
+# Biases every real instrument has at some level (and the ``realistic`` preset's recordings
+# carry): always in the kinematic fit, so they never leak into correlated parameters (a
+# V scale factor, a skew); named only when significant and of practical size.
+NUISANCE_BIASES = ("alpha", "beta", "p", "q", "r", "ax", "ay", "az")
+# A scale factor whose column is this correlated with its channel's bias column cannot be
+# told from that bias (a channel that hardly moves about its mean): not a candidate.
+MAX_SCALE_BIAS_CORRELATION = 0.99
+# A scale factor or time skew needs the channel to move: its own optimal smoothing must vary
+# by this many times the channel's noise level, or the column is mostly (coloured) noise and
+# the estimate an errors-in-variables artefact (a_x in a short maneuver: 0.7 times).
+MIN_EXCITATION = 3.0
 UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s", "phi": "rad",
          "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
 
@@ -128,19 +139,31 @@ def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.
 class KinematicResult:
     selection: ColoredSelection
     parameters: dict[str, SensorParameter]
+    forced: tuple[str, ...]           # the nuisance biases, always in the fit
+    dropped: dict[str, str]           # candidates left out, and why
     equations: tuple[str, ...]
     weights: dict[str, float]
     residual_rms: dict[str, float]   # per equation, before (weighted units removed)
     start: np.ndarray                # stacked weighted residual before corrections
 
 
-def kinematic_check(p: Prepared, *, t_in: float = 6.0, min_gain: float = 0.02, max_terms: int = 8) -> KinematicResult:
+T_IN = 6.0
+
+
+def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, max_terms: int = 8) -> KinematicResult:
     """Select the sensor parameters the kinematics call for (module docstring).
 
     The entry t is 6 rather than the aerodynamic 5: the kinematic residuals carry the
     differentiated airspeed and angle noise, strongly coloured, and on null recordings the
-    airspeed scale and bias reach |t| ≈ 4.6."""
+    airspeed scale and bias reach |t| ≈ 4.6.
+
+    The sensitivity columns J are evaluated on each channel's own optimal smoothing, not on
+    the raw channels: built from the raw ones they carry the same noise as the residual, and
+    that errors-in-variables correlation biases the estimates (with white noise alone, a V
+    scale factor of +0.23 ± 0.07 on a flight that has none). The biases of
+    ``NUISANCE_BIASES`` are always in the fit."""
     ch = dict(p.raw)
+    clean = {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in p.raw}
     # The first and last second are where the sine-series filter is least accurate.
     k = max(1, int(round(1.0 / p.dt)))
     inner = slice(k, p.n - k)
@@ -151,12 +174,30 @@ def kinematic_check(p: Prepared, *, t_in: float = 6.0, min_gain: float = 0.02, m
     params = {sp.name: sp for sp in sensor_parameters(p)}
     columns = {}
     for name, sp in params.items():
-        plus = kinematic_residuals(sp.correct(ch, p, sp.step), p)
-        minus = kinematic_residuals(sp.correct(ch, p, -sp.step), p)
+        plus = kinematic_residuals(sp.correct(clean, p, sp.step), p)
+        minus = kinematic_residuals(sp.correct(clean, p, -sp.step), p)
         # E(0) ≈ −J θ: regress E(0) on −J
         columns[name] = np.concatenate([-(plus[e][inner] - minus[e][inner]) / (2 * sp.step) * weights[e] for e in eqs])
-    sel = colored_forward_selection(stack, columns, t_in=t_in, min_gain=min_gain, max_terms=max_terms, constant=False)
-    return KinematicResult(selection=sel, parameters=params, equations=eqs, weights=weights,
+    dropped = {}
+    for c in set(SCALE_CHANNELS) | set(SKEW_CHANNELS):
+        moves = float(np.std(clean[c][inner])) if c in clean else 0.0
+        if c in p.noise_std and moves < MIN_EXCITATION * p.noise_std[c]:
+            for kind in ("scale", "skew"):
+                if columns.pop(f"{kind}_{c}", None) is not None:
+                    dropped[f"{kind}_{c}"] = (f"{c} hardly moves ({moves / max(p.noise_std[c], 1e-300):.1f} times its "
+                                              f"noise level): a {kind} cannot be told from noise")
+    for c in SCALE_CHANNELS:
+        s, b = columns.get(f"scale_{c}"), columns.get(f"bias_{c}")
+        if s is not None and b is not None and np.ptp(s) > 0 and np.ptp(b) > 0:
+            corr = abs(float(np.corrcoef(s, b)[0, 1]))
+            if corr > MAX_SCALE_BIAS_CORRELATION:
+                dropped[f"scale_{c}"] = f"indistinguishable from bias_{c} (correlation {corr:.3f}): {c} hardly moves"
+                columns.pop(f"scale_{c}")
+    forced = {f"bias_{c}": columns.pop(f"bias_{c}") for c in NUISANCE_BIASES if f"bias_{c}" in columns}
+    sel = colored_forward_selection(stack, columns, forced=forced, t_in=t_in, min_gain=min_gain, max_terms=max_terms,
+                                    constant=False)
+    return KinematicResult(selection=sel, parameters=params, forced=tuple(forced), dropped=dropped,
+                           equations=eqs, weights=weights,
                            residual_rms={e: float(np.sqrt(np.mean(e0[e][inner] ** 2))) for e in eqs}, start=stack)
 
 

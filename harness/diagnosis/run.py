@@ -103,8 +103,10 @@ def _effect_of(c: Candidate) -> HiddenEffect | None:
 
 
 def _findings(analysis: Analysis) -> list[Candidate]:
+    """The selected candidates, most significant first; turbulence, when named, leads: it is
+    the broadband mismatch every deterministic term is then fitted against."""
     chosen = [c for c in analysis.candidates if c.selected]
-    return sorted(chosen, key=lambda c: -abs(c.t))
+    return sorted(chosen, key=lambda c: (c.effect != "turbulence", -abs(c.t)))
 
 
 def _sim_channels(hist) -> dict[str, np.ndarray]:
