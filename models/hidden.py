@@ -11,7 +11,8 @@ convention of effects.md:
   slope, at trim;
 - ``coefficient_error``: C += size · x, x one of α − α_ref, β, p̂, q̂, r̂, δ − δ_ref
   (``regressor``; size is the change of that derivative);
-- ``cross_coupling``: C += size · (α − α_ref)·β;
+- ``cross_coupling``: C += size · (α − α_ref)·β, or with ``regressor='beta_abs'``
+  C += size · |β| (a response even in sideslip, which a symmetric airframe should not have);
 - ``flight_condition_drift``: C += size · (V − V_ref)/V_ref;
 - ``cg_offset``: the moment reference moves ``size`` ft forward: Cm += size·CZ/c̄,
   Cn −= size·CY/b;
@@ -89,6 +90,8 @@ class HiddenEffect:
             raise ValueError(f"coefficient must be one of {COEFFICIENTS}")
         if self.effect == "coefficient_error" and self.regressor not in REGRESSORS:
             raise ValueError(f"coefficient_error needs a regressor among {REGRESSORS}")
+        if self.effect == "cross_coupling" and self.regressor not in ("", "beta_abs"):
+            raise ValueError("cross_coupling takes regressor '' ((alpha - alpha_ref)*beta) or 'beta_abs' (|beta|)")
         if self.effect == "nonlinear_alpha" and self.power not in (2, 3):
             raise ValueError("nonlinear_alpha takes power 2 or 3")
         if self.effect in ("sensor_bias", "sensor_scale", "sensor_time_skew") and self.channel not in SENSOR_CHANNELS:
@@ -123,7 +126,7 @@ class HiddenEffect:
         if self.effect == "coefficient_error":
             return f"{self.coefficient}_{self.regressor}"
         if self.effect == "cross_coupling":
-            return f"{self.coefficient}_alpha_beta"
+            return f"{self.coefficient}_{self.regressor or 'alpha_beta'}"
         if self.effect == "flight_condition_drift":
             return f"{self.coefficient}_dV"
         if self.effect == "cg_offset":
@@ -160,6 +163,8 @@ def _factor(parent: ET.Element, name: str, ref: float, surfaces: dict[str, str])
         _difference(parent, "aero/alpha-rad", ref)
     elif name == "beta":
         _prop(parent, "aero/beta-rad")
+    elif name == "beta_abs":
+        _prop(ET.SubElement(parent, "abs"), "aero/beta-rad")
     elif name in ("phat", "rhat"):
         _prop(parent, "aero/bi2vel")
         _prop(parent, f"velocities/{name[0]}-aero-rad_sec")
@@ -180,7 +185,7 @@ def _factor(parent: ET.Element, name: str, ref: float, surfaces: dict[str, str])
 
 def _factors(e: HiddenEffect) -> tuple[str, ...]:
     return {"unsteady_alphadot": ("alphadot",), "nonlinear_alpha": ("alpha",) * e.power,
-            "coefficient_error": (e.regressor,), "cross_coupling": ("alpha", "beta"),
+            "coefficient_error": (e.regressor,), "cross_coupling": (e.regressor,) if e.regressor else ("alpha", "beta"),
             "flight_condition_drift": ("dV",)}[e.effect]
 
 

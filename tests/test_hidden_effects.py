@@ -77,3 +77,21 @@ def test_bad_hidden_effects_are_refused():
         HiddenEffect("gremlins", 1.0)
     with pytest.raises(ValueError, match="non-negative"):
         HiddenEffect("control_delay", -0.1)
+
+
+def test_cross_coupling_in_abs_beta_is_even_in_sideslip():
+    """C_l += k·|β|: the same increment at +β and −β, zero at β = 0 (the diagnosis's term for
+    a model whose rolling moment is even in sideslip, as the package DHC6's is)."""
+    from models.replay import InitialCondition, aero_along
+    ic = InitialCondition(10_000.0, 500.0)
+    n = 3
+    states = {"V": np.full(n, 500.0), "alpha": np.full(n, 0.03), "beta": np.array([-0.05, 0.0, 0.05]),
+              "p": np.zeros(n), "q": np.zeros(n), "r": np.zeros(n), "phi": np.zeros(n), "theta": np.full(n, 0.03)}
+    surfaces = {"de": np.full(n, -0.02), "da": np.zeros(n), "dr": np.zeros(n)}
+    effect = HiddenEffect("cross_coupling", 0.3, coefficient="Cl", regressor="beta_abs")
+    assert effect.parameter == "Cl_beta_abs"
+    base = aero_along(Aircraft("f16"), ic, states, surfaces).coefficients["Cl"]
+    added = aero_along(Aircraft("f16", hidden=(effect,)), ic, states, surfaces).coefficients["Cl"]
+    assert added - base == pytest.approx([0.3 * 0.05, 0.0, 0.3 * 0.05], abs=1e-9)
+    with pytest.raises(ValueError, match="beta_abs"):
+        HiddenEffect("cross_coupling", 0.3, coefficient="Cl", regressor="beta")

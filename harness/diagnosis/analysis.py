@@ -148,12 +148,14 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     delays = {}
     for s in ("de", "da", "dr"):
         scan = cand.delay_scan(p, s, mismatch, aero.derivatives, noise)
-        if scan is not None:
+        # a delay refined beyond the scanned range is not an actuator delay: its column is
+        # not offered (it would stand in for some other model error)
+        if scan is not None and scan.tau_s <= cand.DELAY_GRID_S[-1]:
             delays[s] = scan
     # 5. per-axis stepwise
     selections = {}
     for axis in COEFFICIENTS:
-        terms = cand.library(p, axis, aero.derivatives, measured)
+        terms = cand.library(p, axis, aero.derivatives, measured, aero.coefficients)
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
         sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra)
         selections[axis] = (sel, {t.key: t for t in terms})
@@ -217,18 +219,23 @@ def _aero_candidates(selections: dict, delays: dict, dt: float) -> list[Candidat
             out.append(Candidate(term.effect, cand.AXIS_NAME[axis], axis, term.parameter, est, se, t.t, t.gain,
                                  term.units, f"stepwise on the {axis} mismatch", t.selected,
                                  "entered" if t.selected else "not entered",
-                                 {"change": t.estimate} if term.effect == "coefficient_error" else {}))
+                                 {"change": t.estimate, "model_over_maneuver": term.details["model_value"],
+                                  "model_at_trim": term.details["trim_value"]}
+                                 if term.effect == "coefficient_error" else {}))
     for s, rows in delay_seen.items():
         scan = delays[s]
         # significance from the stepwise entry of the delay column (its coefficient is τ);
         # size and standard error from the scan's linearised fit
         best = max(rows, key=lambda r: abs(r[1].t))[1]
         entered = any(t.selected for _, t in rows)
-        sel = entered and scan.tau_s >= PRACTICAL_DELAY_SAMPLES * dt
+        inside = scan.tau_s <= cand.DELAY_GRID_S[-1]
+        sel = entered and inside and scan.tau_s >= PRACTICAL_DELAY_SAMPLES * dt
         gain = max(t.gain for _, t in rows)
         out.append(Candidate("control_delay", "pitch" if s == "de" else ("roll" if s == "da" else "yaw"), s, f"tau_{s}",
                              scan.tau_s, scan.std_error, best.t, gain, "s", f"delay scan of {s} + stepwise", sel,
-                             "entered" if sel else ("entered, but under two samples" if entered else "not entered"),
+                             "entered" if sel else ("not entered" if not entered else
+                                                    "entered, but the delay lies beyond the scanned 0-0.3 s: not an "
+                                                    "actuator delay" if not inside else "entered, but under two samples"),
                              {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
     if cg_seen:
         axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))

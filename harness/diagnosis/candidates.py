@@ -56,18 +56,43 @@ def regressors(p: Prepared) -> dict[str, np.ndarray]:
     return out
 
 
-def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dict[str, np.ndarray]) -> list[Term]:
-    """The candidate terms for the mismatch of coefficient ``axis``."""
+def effective_derivatives(p: Prepared, axis: str, model: np.ndarray) -> dict[str, float]:
+    """The model's own derivatives of ``axis`` over this maneuver: its coefficient along the
+    recorded states regressed on the axis's own regressors (and a constant). Equal to the
+    trim derivatives for a linear model; for a model whose derivatives vary with the state
+    (a C_n,β that changes with α, say) they are the values the maneuver actually saw, which
+    the mismatch's changes are relative to."""
+    reg = regressors(p)
+    names = [r for r in (("alpha", "qhat", "de") if axis in LON else ("beta", "phat", "rhat", "da", "dr"))
+             if r in reg and np.ptp(reg[r]) > 0]
+    if not names:
+        return {}
+    k = max(1, int(round(1.0 / p.dt)))
+    A = np.column_stack([reg[r][k:-k] for r in names] + [np.ones(p.n - 2 * k)])
+    theta, *_ = np.linalg.lstsq(A, model[k:-k], rcond=None)
+    return {f"{axis}_{r}": float(v) for r, v in zip(names, theta)}
+
+
+def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dict[str, np.ndarray],
+            model: dict[str, np.ndarray] | None = None) -> list[Term]:
+    """The candidate terms for the mismatch of coefficient ``axis``. With ``model`` (the
+    model's coefficients along the recorded states) a coefficient error's model value is the
+    model's effective derivative over the maneuver (:func:`effective_derivatives`), else its
+    trim derivative."""
     geo = p.meta["geometry"]
     reg = regressors(p)
     a = reg["alpha"]
     units_rate = "per rad (rates normalised by c/2V or b/2V)"
     own = ("alpha", "qhat", "de") if axis in LON else ("beta", "phat", "rhat", "da", "dr")
+    values = dict(derivatives)
+    if model is not None:
+        values.update(effective_derivatives(p, axis, model[axis]))
     terms = []
     for r in own:
         if r in reg:
             terms.append(Term(r, "coefficient_error", f"{axis}_{r}", units_rate, reg[r],
-                              details={"model_value": derivatives.get(f"{axis}_{r}", float("nan"))}))
+                              details={"model_value": values.get(f"{axis}_{r}", float("nan")),
+                                       "trim_value": derivatives.get(f"{axis}_{r}", float("nan"))}))
     if axis in LON:
         adot = p.deriv["alpha"] * geo["cbar_ft"] / (2.0 * p.smooth["V"])
         terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)", adot))
@@ -75,6 +100,9 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
         terms.append(Term("alpha3", "nonlinear_alpha", f"{axis}_alpha3", "per rad^3", a ** 3))
     else:
         terms.append(Term("alpha_beta", "cross_coupling", f"{axis}_alpha_beta", "per rad^2", a * reg["beta"]))
+        # a response even in sideslip: wrong for a symmetric airframe, yet easy to tabulate (β
+        # itself, not its change from the start: the kink is at zero sideslip)
+        terms.append(Term("beta_abs", "cross_coupling", f"{axis}_beta_abs", "per rad", np.abs(p.smooth["beta"])))
     V0 = p.start["V"]
     terms.append(Term("dV", "flight_condition_drift", f"{axis}_dV", "per unit dV/V", (p.smooth["V"] - V0) / V0))
     if axis == "Cm":

@@ -33,13 +33,13 @@ EXPLAIN = {
     "control_delay": "The model responds to {channel} too early: the surface acts about {estimate:.3f} ± "
                      "{std_error:.3f} s after the recorded position (an actuator delay the model lacks).",
     "sensor_offset": "The accelerometer is not at the c.g.: its readings carry the rotational terms of a sensor "
-                     "about {estimate:.2f} ± {std_error:.2f} ft ahead of it (x).",
+                     "about {abs_estimate:.2f} ± {std_error:.2f} ft {ahead} of it (x).",
     "nonlinear_alpha": "The {axis} mismatch curves with angle of attack: the model lacks a nonlinear term, "
                        "{parameter} = {estimate:.3g} ± {std_error:.2g} {units}.",
     "coefficient_error": "The model's {parameter} is off: the data say {estimate:.4g} ± {std_error:.2g} {units}, "
-                         "the model has {model_value:.4g}.",
-    "cross_coupling": "The {axis} mismatch follows (alpha - alpha_trim)·beta: a coupling term {parameter} = "
-                      "{estimate:.3g} ± {std_error:.2g} {units} is missing.",
+                         "the model has {model_value:.4g} over this maneuver ({model_at_trim:.4g} at its trim).",
+    "cross_coupling": "The {axis} mismatch follows {product}: a coupling term {parameter} = "
+                      "{estimate:.3g} ± {std_error:.2g} {units} is missing{even}.",
     "flight_condition_drift": "The {axis} mismatch trends with the airspeed change: {parameter} = {estimate:.3g} ± "
                               "{std_error:.2g} per unit dV/V.",
     "cg_offset": "The moment reference is {estimate:.2f} ± {std_error:.2f} ft away from where the model puts it "
@@ -85,7 +85,10 @@ def _effect_of(c: Candidate) -> HiddenEffect | None:
         return HiddenEffect(e, c.estimate, coefficient=coef, power=int(c.parameter[-1]))
     if e == "coefficient_error":
         return HiddenEffect(e, c.details["change"], coefficient=coef, regressor=c.parameter.split("_", 1)[1])
-    if e in ("cross_coupling", "flight_condition_drift"):
+    if e == "cross_coupling":
+        return HiddenEffect(e, c.estimate, coefficient=coef, regressor="beta_abs" if c.parameter.endswith("_beta_abs")
+                            else "")
+    if e == "flight_condition_drift":
         return HiddenEffect(e, c.estimate, coefficient=coef)
     if e == "cg_offset":
         return HiddenEffect(e, c.estimate)
@@ -97,8 +100,10 @@ def _effect_of(c: Candidate) -> HiddenEffect | None:
         else:  # the kinematic check: one component (offset_x, offset_y, offset_z)
             pos = tuple(float(c.estimate) if c.parameter == f"offset_{a}" else 0.0 for a in "xyz")
         return HiddenEffect(e, pos[0], position_ft=pos)
-    if e in ("sensor_bias", "sensor_scale", "sensor_time_skew") and c.channel in _CHANNEL_COLUMNS:
-        return HiddenEffect(e, c.estimate, channel=c.channel)
+    if e in ("sensor_bias", "sensor_scale", "sensor_time_skew"):
+        channel = c.channel if c.channel in _CHANNEL_COLUMNS else c.parameter.split("_", 1)[1]
+        if channel in _CHANNEL_COLUMNS:
+            return HiddenEffect(e, c.estimate, channel=channel)
     return None
 
 
@@ -133,7 +138,7 @@ def _after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, n
         if f.channel not in COEFFICIENTS:
             continue
         terms = {t.parameter if t.effect != "coefficient_error" else t.parameter: t
-                 for t in cand.library(p, f.channel, a.aero.derivatives, measured)}
+                 for t in cand.library(p, f.channel, a.aero.derivatives, measured, a.aero.coefficients)}
         term = terms.get(f.parameter)
         if term is None:
             continue
@@ -172,6 +177,19 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
             "change": ratio - 1.0}
 
 
+def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
+    """The initial condition with the found sensor errors of V, α and h undone (recorded =
+    x + b, (1 + k)·x): the augmented model must start where the aircraft was, not where
+    its instruments said it was."""
+    ch = {c: p.smooth[c].copy() for c in ("V", "alpha", "h") if c in p.smooth}
+    for e in added:
+        if e.channel in ch and e.effect == "sensor_bias":
+            ch[e.channel] = ch[e.channel] - e.size
+        elif e.channel in ch and e.effect == "sensor_scale":
+            ch[e.channel] = ch[e.channel] / (1.0 + e.size)
+    return initial_condition(p.t, ch["V"], ch["alpha"], ch.get("h"))
+
+
 def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
               findings: list[Candidate] | None, analysis: Analysis):
     """Replays before/after and fits for one analysed maneuver; on the validation maneuver
@@ -182,7 +200,7 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
     after_hist, diverged = before_hist, None
     if added:
         try:
-            after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), ic, p.t, surfaces)
+            after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), _true_start(p, added), p.t, surfaces)
         except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient fits still stand
             after_hist, diverged = None, str(exc)
     a = analysis
@@ -259,6 +277,12 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
            "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
     if c.effect == "coefficient_error":
         fmt["model_value"] = c.estimate - c.details["change"]
+        fmt["model_at_trim"] = c.details.get("model_at_trim", float("nan"))
+    fmt["abs_estimate"], fmt["ahead"] = abs(c.estimate), "ahead" if c.estimate >= 0 else "behind"
+    even = c.parameter.endswith("_beta_abs")
+    fmt["product"] = "|beta|, an even function of sideslip" if even else "(alpha - alpha_trim)·beta"
+    fmt["even"] = (" (or, as here, the model has one of opposite sign: a symmetric airframe's rolling and yawing "
+                   "moments are odd in sideslip)") if even else ""
     try:
         text = EXPLAIN[c.effect].format(**fmt)
     except (KeyError, ValueError):
