@@ -202,9 +202,34 @@ def report_rows(target_rows: int = 100_000) -> list[BenchRow]:
                      "scores + all figures + HTML/Markdown/JSON; target < 30 s")]
 
 
+def diagnosis_rows(repeat: int) -> list[BenchRow]:
+    """The discrepancy diagnosis of a 30 s gallery recording with its validation maneuver
+    (analysis, the validation check, four replays, findings and series written), and of the
+    Twin Otter flight data against the DHC6 when ``../shared`` is there. The HTML report
+    (reports package) is timed by the walkthrough, not here: the harness never imports it."""
+    import tempfile
+    from pathlib import Path
+
+    from harness.diagnosis.gallery import case, write_case
+    from harness.diagnosis.run import diagnose
+
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = write_case(case("unsteady_alphadot"), Path(tmp) / "rec", seed=1)
+        seconds = best_of(lambda: diagnose("f16", paths["identification"], Path(tmp) / "d",
+                                           paths["validation"]), repeat)
+        out.append(BenchRow("diagnose a 30 s F-16 recording + validation", seconds, "s", "bar < 60 s"))
+        data = Path(__file__).resolve().parents[2] / "shared" / "data" / "sidpac"
+        ident, valid = data / "totter_f1_017_data.mat", data / "totter_f1_014_data.mat"
+        if ident.is_file() and valid.is_file():
+            seconds = best_of(lambda: diagnose("dhc6", ident, Path(tmp) / "t", valid, mass="recording"), repeat)
+            out.append(BenchRow("diagnose Twin Otter 017 + 014 against the DHC6", seconds, "s", "20 s records"))
+    return out
+
+
 def rows(repeat: int) -> list[BenchRow]:
     """All benchmark rows, in order."""
-    return flight_rows(repeat) + estimator_rows(repeat) + campaign_rows() + report_rows()
+    return flight_rows(repeat) + estimator_rows(repeat) + campaign_rows() + report_rows() + diagnosis_rows(repeat)
 
 
 def format_rows(table: list[BenchRow]) -> str:
