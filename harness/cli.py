@@ -135,6 +135,18 @@ def _parser() -> argparse.ArgumentParser:
     gg.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
     gg.set_defaults(func="harness.diagnosis.commands:cmd_gallery")
 
+    sw = sub.add_parser("diagnosis-sweep", help="score the diagnosis on concealed effects of every id, sizes and "
+                                                "maneuvers against the outside bar",
+                        description="Fly about seventy F-16 recordings with one concealed effect each (every id of "
+                                    "effects.md, several sizes, surfaces and maneuvers) and null recordings, "
+                                    "diagnose each and score it: right effect first, size within 2 s.e. or 25 %, "
+                                    "none on nulls, validation RMS -30 %. Writes OUT/sweep.md, OUT/sweep.json and "
+                                    "one result per case (a rerun resumes).")
+    sw.add_argument("--out", default="out/sweep", help="output folder")
+    sw.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
+    sw.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    sw.set_defaults(func="harness.diagnosis.commands:cmd_sweep")
+
     r = sub.add_parser("report", help="turn campaign output into HTML, Markdown and JSON reports",
                        description="Write report.html (self-contained), report.md and report.json for a campaign "
                                    "output folder; --kind benchmark ranks the methods over one or more folders.")

@@ -225,3 +225,39 @@ def test_twin_otter_against_the_dhc6(shared_dir, tmp_path):
     for c in ("Cl", "Cn"):
         assert after[c]["rms"] < 0.5 * before[c]["rms"], c
     assert r["inputs"]["mass"] == "recording" and r["model"]["augmented_xml"].endswith("DHC6-mass-diagnosed.xml")
+
+
+def test_sweep_scores_against_the_outside_bar():
+    """The four conditions, on hand-made findings: size within 2 s.e. or 25 %, a coefficient
+    error judged by its change, the validation drop of 30 %."""
+    from harness.diagnosis.sweep import SweepCase, markdown, passes, score
+
+    def result(effect, parameter, estimate, se, before=1.0, after=0.5, **evidence):
+        fit = {"validation": {"outputs": {"q": {"rms": before}}}}
+        fit_after = {"validation": {"outputs": {"q": {"rms": after}}}}
+        return {"findings": [{"effect": effect, "parameter": parameter, "estimate": estimate, "std_error": se,
+                              "evidence": evidence, "fit_before": fit, "fit_after": fit_after}]}
+    c = SweepCase("delay", (), "control_delay", "tau_de", 0.08, "q")
+    assert passes(score(c, result("control_delay", "tau_de", 0.11, 0.016)))           # 2 s.e.
+    assert not score(c, result("control_delay", "tau_de", 0.13, 0.016))["b"]          # neither
+    assert not score(c, result("control_delay", "tau_de", 0.08, 0.01, after=0.75))["d"]
+    assert not score(c, result("unsteady_alphadot", "Cm_alphadot", -3, 0.1))["a"]
+    ce = SweepCase("ce", (), "coefficient_error", "Cm_qhat", -3.0, "q")
+    assert score(ce, result("coefficient_error", "Cm_qhat", -8.0, 0.1, change=-2.9))["b"]
+    null = SweepCase("none")
+    row = score(null, result("none", "", 0.0, 0.0))
+    assert row["a"] and row["c"] and passes(row)
+    assert "1 of 1 cases meet every condition" in markdown([row])
+
+
+def test_sweep_runs_and_resumes(tmp_path):
+    from harness.diagnosis.sweep import sweep
+    rows = sweep(tmp_path, ["none_s2"], workers=1)
+    assert rows[0]["c"] is True
+    result = tmp_path / "results" / "none_s2.json"
+    stamp = result.stat().st_mtime_ns
+    again = sweep(tmp_path, ["none_s2"], workers=1)
+    assert again == rows and result.stat().st_mtime_ns == stamp      # read back, not rerun
+    assert (tmp_path / "sweep.md").read_text().count("| none_s2 |") == 1
+    with pytest.raises(ValueError, match="no sweep case"):
+        sweep(tmp_path, ["gremlin"])

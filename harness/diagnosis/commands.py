@@ -1,4 +1,4 @@
-"""The ``sidbench gallery`` subcommand."""
+"""The ``sidbench gallery`` and ``sidbench diagnosis-sweep`` subcommands."""
 from __future__ import annotations
 
 import argparse
@@ -11,4 +11,12 @@ def cmd_gallery(args: argparse.Namespace) -> int:
     for name in names:
         paths = write_case(case(name), args.out, args.seed)
         print(f"{name}: {paths['identification']} and {paths['validation']}")
+    return 0
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from harness.diagnosis.sweep import markdown, sweep
+    rows = sweep(args.out, args.case, args.workers)
+    print(markdown(rows))
+    print(f"wrote {args.out}/sweep.md and sweep.json")
     return 0

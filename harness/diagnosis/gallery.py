@@ -116,14 +116,18 @@ def conceal(rec):
     return type(rec)(data=data, meta=meta, name=rec.name), answer
 
 
-def write_case(c: GalleryCase, out_dir: str | Path, seed: int = 1) -> dict[str, Path]:
+def write_case(c: GalleryCase, out_dir: str | Path, seed: int = 1,
+               inputs: tuple[Sequence, Sequence] | None = None) -> dict[str, Path]:
     """Fly, corrupt and write one case: ``<case>-identification.csv`` and
-    ``<case>-validation.csv`` (noise seeds ``seed`` and ``seed + 1``) and the answer."""
+    ``<case>-validation.csv`` (noise seeds ``seed`` and ``seed + 1``) and the answer.
+    ``inputs`` replaces the gallery's identification and validation inputs."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths, answers = {}, {}
-    for i, (role, inputs) in enumerate((("identification", identification_input()), ("validation", validation_input()))):
-        spec = FlightSpec(input=inputs, aircraft=Aircraft("f16", hidden=c.effects), duration_s=DURATION_S)
+    maneuvers = inputs or (identification_input(), validation_input())
+    for i, (role, inputs_) in enumerate(zip(("identification", "validation"), maneuvers)):
+        spec = FlightSpec(input=inputs_, aircraft=Aircraft("f16", hidden=c.effects),
+                          duration_s=max(DURATION_S, inputs_.duration_s))
         if c.turbulence is not None:
             spec = replace(spec, turbulence=c.turbulence, turbulence_seed=100 * seed + i)
         rec = fly_maneuver(spec)
