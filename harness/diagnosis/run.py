@@ -3,7 +3,6 @@ its output folder: findings.json, series/*.parquet, model/ (the augmented JSBSim
 from __future__ import annotations
 
 import json
-import shutil
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -252,6 +251,17 @@ def structured_part(p: Prepared, mismatch: np.ndarray) -> np.ndarray:
     return fitted - fitted.mean()
 
 
+def _focus_axis(findings: list[Candidate]) -> str | None:
+    """The coefficient axis of the first aerodynamic or actuator finding (a delay: the axis
+    its surface mainly drives)."""
+    for f in findings:
+        if f.channel in COEFFICIENTS:
+            return f.channel
+        if f.effect == "control_delay":
+            return {"de": "Cm", "da": "Cl", "dr": "Cn"}.get(f.channel)
+    return None
+
+
 def _located(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> dict:
     """Where model and recording part: per output channel and per axis, and in time and
     frequency for ``focus`` (the axis of the first finding; else the axis whose mismatch
@@ -285,7 +295,7 @@ def _located(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> d
     band = [float(f[int(np.searchsorted(cum, 0.1))]), float(f[min(int(np.searchsorted(cum, 0.9)), f.size - 1)])]
     ranked = sorted(coefs, key=lambda c: -coefs[c]["structured_ratio"])[:3]
     where = (f"the findings put it in {axis}" if focus in coefs else f"it is largest in {axis}")
-    summary = (f"Coefficient mismatch that follows the maneuver, in noise levels: "
+    summary = ("Coefficient mismatch that follows the maneuver, in noise levels: "
                + ", ".join(f"{c} {coefs[c]['structured_ratio']:.1f}" for c in ranked)
                + f"; {where}, most between t = {p.t[i]:.1f} and {p.t[min(i + w, p.n - 1)]:.1f} s, with 80 % of "
                f"its power in {band[0]:.2f}-{band[1]:.2f} Hz.")
@@ -398,11 +408,7 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
     _, fb_id, fa_id, series_id = _maneuver(p, aircraft, added, modelled, a)
     fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
     series = {"identification": series_id}
-    focus = next((f.channel if f.channel in COEFFICIENTS else cand.SURFACE_AXES.get(f.channel, (None,))[0]
-                  for f in findings if f.channel in COEFFICIENTS or f.effect == "control_delay"), None)
-    if focus is not None and any(f.effect == "control_delay" and f.channel in cand.SURFACE_AXES for f in findings[:1]):
-        focus = {"de": "Cm", "da": "Cl", "dr": "Cn"}[findings[0].channel]
-    located = _located(a, fb_id, "identification", focus)
+    located = _located(a, fb_id, "identification", _focus_axis(findings))
     located["remaining"] = _remaining(a, fb_id, fa_id)
     if findings:
         worst = max(located["remaining"], key=lambda c: located["remaining"][c]["ratio"])
