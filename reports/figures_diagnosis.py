@@ -286,6 +286,20 @@ def fig_mismatch_spectrum(series: pd.DataFrame | None, worst: str | None = None,
     return done(fig, "mismatch_spectrum", caption, alt)
 
 
+def _before_after_panels(series: pd.DataFrame | None, names: Sequence[str], need: Sequence[str],
+                         window: Sequence[float] | None, panel_height: float):
+    """The names (at most ``MAX_CHANNELS``) whose ``need`` columns the series has, the time,
+    the shaded span and a figure with one stacked panel each; None when nothing can be drawn."""
+    if not _has(series, ["t_s"]):
+        return None
+    chosen = [c for c in names if _has(series, [n.format(c) for n in need])][:MAX_CHANNELS]
+    if not chosen:
+        return None
+    fig = new_figure(1.0 + panel_height * len(chosen))
+    axes = fig.subplots(len(chosen), 1, sharex=True, squeeze=False).ravel()
+    return chosen, _time(series), _window(window), fig, axes
+
+
 def fig_before_after_outputs(series: pd.DataFrame | None, channels: Sequence[str], maneuver: str,
                              window: Sequence[float] | None = None) -> FigureOut | None:
     """Smoothed measurement, model as given and augmented model for the affected channels.
@@ -305,15 +319,11 @@ def fig_before_after_outputs(series: pd.DataFrame | None, channels: Sequence[str
     -------
     FigureOut or None
     """
-    if not _has(series, ["t_s"]):
-        return None
     need = ("smooth_{}", "before_{}", "after_{}")
-    chans = [c for c in channels if _has(series, [n.format(c) for n in need])][:MAX_CHANNELS]
-    if not chans:
+    panels = _before_after_panels(series, channels, need, window, 2.0)
+    if panels is None:
         return None
-    t, span = _time(series), _window(window)
-    fig = new_figure(1.0 + 2.0 * len(chans))
-    axes = fig.subplots(len(chans), 1, sharex=True, squeeze=False).ravel()
+    chans, t, span, fig, axes = panels
     changes = []
     for ax, c in zip(axes, chans):
         smooth, before, after = (channel_values(series, n.format(c), c) for n in need)
@@ -356,15 +366,11 @@ def fig_before_after_coefs(series: pd.DataFrame | None, coefs: Sequence[str], ma
     -------
     FigureOut or None
     """
-    if not _has(series, ["t_s"]):
-        return None
     need = ("coef_meas_{}", "coef_model_{}", "coef_after_{}")
-    chosen = [j for j in coefs if _has(series, [n.format(j) for n in need])][:MAX_CHANNELS]
-    if not chosen:
+    panels = _before_after_panels(series, coefs, need, window, 1.9)
+    if panels is None:
         return None
-    t, span = _time(series), _window(window)
-    fig = new_figure(1.0 + 1.9 * len(chosen))
-    axes = fig.subplots(len(chosen), 1, sharex=True, squeeze=False).ravel()
+    chosen, t, span, fig, axes = panels
     changes = []
     for ax, j in zip(axes, chosen):
         before, after = _mismatch(series, j, "model"), _mismatch(series, j, "after")
