@@ -21,6 +21,8 @@ def _parser() -> argparse.ArgumentParser:
         prog="sidbench",
         description="Validation harness for aircraft parameter estimation: JSBSim flies the "
                     "maneuvers, estimators recover known coefficients, the harness scores them.")
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of user errors too (one line and exit status 2 without it)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
     f = sub.add_parser("fly", help="trim an aircraft, fly a maneuver and write the recording",
@@ -205,17 +207,15 @@ def _single_threaded_blas() -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``sidbench`` console script."""
     _single_threaded_blas()
-    args = _parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv  # accepted anywhere on the line, before or after the subcommand
+    args = _parser().parse_args([a for a in argv if a != "--debug"])
     module, name = args.func.split(":")
     import importlib
 
-    from harness.errors import USER_ERRORS
+    from harness.errors import run_reporting_errors
     func = getattr(importlib.import_module(module), name)
-    try:
-        return int(func(args) or 0)
-    except USER_ERRORS as exc:
-        print(f"sidbench {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    return run_reporting_errors(func, args, args.command, debug=debug)
 
 
 if __name__ == "__main__":

@@ -1,15 +1,105 @@
-"""The errors a user can act on: printed as one line naming the cause, exit status 2."""
+"""User errors and internal errors, and how the command line reports them.
+
+* A **user error** is something the user can fix: a malformed recording, a bad campaign file
+  or option, an output path that cannot be written, a trim that fails. It is printed as one
+  line naming the file, the column or key, and the rule, and the command exits with status 2.
+  ``--debug`` adds the traceback.
+* An **interruption** (Ctrl-C) prints one line (with how to resume, where that applies) and
+  exits with status 130.
+* Anything else is an **internal error** (a bug): its traceback is printed, followed by one
+  line saying so, and the command exits with status 1.
+
+New user-facing errors derive from :class:`UserError`. Estimators, models and the diagnosis
+still raise plain ``ValueError`` for some user-facing problems; those keep the one-line form
+(a compatible mapping), with a pointer to ``--debug``.
+"""
 from __future__ import annotations
 
-from estimators.least_squares import SingularRegressorsError
-from estimators.regressors import EquationError
-from harness.campaign import CampaignError
-from harness.diagnosis.run import DiagnosisError
-from maneuvers.base import InputSpecError
-from maneuvers.recording import RecordingError
-from models.flight import FlightError
-from models.trim import TrimError
+import sys
+import traceback
+from collections.abc import Callable
+from typing import Any, TextIO
 
-USER_ERRORS: tuple[type[BaseException], ...] = (
-    RecordingError, TrimError, FlightError, InputSpecError, SingularRegressorsError, EquationError, CampaignError,
-    DiagnosisError, FileNotFoundError, ValueError)
+
+class UserError(ValueError):
+    """Something the user can fix; the message names the file, key or option and the rule."""
+
+
+class OptionError(UserError):
+    """A command-line option with a value the command cannot use."""
+
+
+class OutputPathError(UserError):
+    """An output file or folder that cannot be written where it was asked for."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C, with a message saying what was kept and how to resume."""
+
+
+EXIT_USER = 2
+EXIT_INTERNAL = 1
+EXIT_INTERRUPTED = 130
+
+# OS errors that name a path the user gave (missing file, a file where a folder is needed...).
+_PATH_ERRORS: tuple[type[BaseException], ...] = (
+    FileNotFoundError, FileExistsError, IsADirectoryError, NotADirectoryError, PermissionError)
+
+
+def user_errors() -> tuple[type[BaseException], ...]:
+    """Every exception type reported as a user error (imported lazily: this module is imported
+    by the modules that define some of them)."""
+    from estimators.least_squares import SingularRegressorsError
+    from estimators.regressors import EquationError
+    from harness.diagnosis.run import DiagnosisError
+    from maneuvers.base import InputSpecError
+    from maneuvers.recording import RecordingError
+    from models.flight import FlightError
+    from models.trim import TrimError
+    return (UserError, RecordingError, TrimError, FlightError, InputSpecError, SingularRegressorsError,
+            EquationError, DiagnosisError, MemoryError) + _PATH_ERRORS
+
+
+def __getattr__(name: str) -> Any:
+    # ``USER_ERRORS`` (the former constant) stays importable, built on first use.
+    if name == "USER_ERRORS":
+        return user_errors() + (ValueError,)
+    raise AttributeError(name)
+
+
+def _one_line(exc: BaseException) -> str:
+    if isinstance(exc, MemoryError):
+        return "out of memory" + (f": {exc}" if str(exc) else "")
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text
+
+
+def run_reporting_errors(func: Callable[[Any], int | None], args: Any, command: str, *, debug: bool = False,
+                         stream: TextIO | None = None) -> int:
+    """Run ``func(args)`` and turn what it raises into a message and an exit status."""
+    err = stream or sys.stderr
+    prefix = f"sidbench {command}"
+    try:
+        return int(func(args) or 0)
+    except KeyboardInterrupt as exc:
+        if debug:
+            traceback.print_exc(file=err)
+        print(f"{prefix}: interrupted" + (f"; {exc}" if str(exc) else ""), file=err)
+        return EXIT_INTERRUPTED
+    except user_errors() as exc:
+        if debug:
+            traceback.print_exc(file=err)
+        print(f"{prefix}: error: {_one_line(exc)}", file=err)
+        return EXIT_USER
+    except ValueError as exc:
+        # Compatible mapping: estimators and models raise plain ValueError for user-facing problems.
+        if debug:
+            traceback.print_exc(file=err)
+        print(f"{prefix}: error: {_one_line(exc)}" + ("" if debug else " (--debug shows the traceback)"),
+              file=err)
+        return EXIT_USER
+    except Exception as exc:  # noqa: BLE001 - a bug: keep its traceback
+        traceback.print_exc(file=err)
+        print(f"{prefix}: internal error (a bug, not your input): {type(exc).__name__}: {_one_line(exc)}",
+              file=err)
+        return EXIT_INTERNAL
