@@ -6,20 +6,22 @@ Parameter Estimation") and described in E. A. Morelli, "Estimating noise
 characteristics from flight test data using optimal Fourier smoothing",
 Journal of Aircraft 32(4), 1995.  The record is represented by a Fourier sine
 series after removing the straight line through its end points; the sine
-coefficients are weighted by a Wiener filter built from a white-noise floor
-and a signal spectrum estimated from the same coefficients; the smoothed
+coefficients are weighted by a Wiener filter built from a noise floor (white,
+or of a known shape such as the floor of a differentiated record, rising with
+frequency) and a signal spectrum estimated from the same coefficients; the smoothed
 record is the weighted series plus the line.  The method is global (all data
 at once) and has zero phase shift by construction.
 
 Public API
 ----------
-optimal_fourier_smoother(x, dt, *, cutoff_hz=None) -> FourierSmoothing
+optimal_fourier_smoother(x, dt, *, cutoff_hz=None, noise_shape=None) -> FourierSmoothing
 FourierSmoothing (frozen result; ``.derivative()`` gives the smoothed
 derivative computed in the frequency domain)
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,8 +48,9 @@ class FourierSmoothing:
     noise : numpy.ndarray, shape (N,)
         ``x - smoothed`` (zero at both end points).
     noise_variance : float
-        **The noise level**: white-noise variance implied by the flat floor
-        of the sine coefficients above the cut-off,
+        **The noise level**: the variance of the noise implied by the floor
+        ``N_k`` of the sine coefficients, ``(N - 1)/2 * mean_k(N_k)`` (by
+        Parseval).  For the white floor this is
         ``sigma^2 = (N - 1)/2 * mean(b_k**2, f_k > cutoff)`` (for white noise
         of variance sigma^2, ``E[b_k**2] = 2 sigma^2/(N - 1)``).  Unbiased
         when the signal has negligible power above the cut-off.
@@ -155,62 +158,81 @@ def _sine_coefficients(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return line, b
 
 
-def _automatic_cutoff(power: np.ndarray) -> tuple[int, float]:
-    """Number of retained coefficients ``k_c`` and white-noise floor ``N``.
+def _automatic_cutoff(power: np.ndarray, shape: np.ndarray | None = None) -> tuple[int, float]:
+    """Number of retained coefficients ``k_c`` and the noise-floor scale ``sigma2``.
 
-    ``k_c`` maximises ``J(k) = sum_{i<=k} (P_i - 2 N)`` (``J(0) = 0``), which
-    is the same as minimising the unbiased estimate
-    ``sum_{i>k} (P_i - N) + k N`` of the summed squared error of the
-    series truncated after ``k`` terms (signal lost above, noise kept below).
-    Its increments have expectation ``S_i - N`` (signal power minus noise
-    floor), so ``J`` rises while the signal is above the floor and falls
-    after: ``k_c`` is where the signal spectrum meets the noise floor.  The
-    floor starts from the robust estimate ``median(P, upper half of the
-    band) / median(chi2_1)`` and is then re-estimated as the mean of the
-    coefficients above the cut-off; the two steps alternate until ``k_c``
-    repeats.  At least ``max(2, ceil(K/100))`` coefficients are kept above
-    the cut-off to estimate the floor.
+    The noise floor is ``N_i = sigma2 * g_i`` with a known shape ``g`` (``None``: white
+    noise, ``g_i = 1``) and an unknown scale. ``k_c`` maximises
+    ``J(k) = sum_{i<=k} (P_i - 2 N_i)`` (``J(0) = 0``), which is the same as minimising the
+    unbiased estimate ``sum_{i>k} (P_i - N_i) + sum_{i<=k} N_i`` of the summed squared error
+    of the series truncated after ``k`` terms (signal lost above, noise kept below; for
+    ``P_i = S_i + noise``, ``E[P_i] = S_i + N_i``). Its increments have expectation
+    ``S_i - N_i``, so ``J`` rises while the signal is above the floor and falls after: ``k_c``
+    is where the signal spectrum meets the floor, whatever the floor's shape. The scale starts
+    from the robust estimate ``median(P_i/g_i, upper half of the band) / median(chi2_1)`` and
+    is then re-estimated from the coefficients above the cut-off as
+    ``sum(P_i) / sum(g_i)`` (unbiased when ``E[P_i] = sigma2 g_i`` there, and not
+    ill-conditioned where ``g`` is small, unlike the mean of ``P_i/g_i``); the two steps
+    alternate until ``k_c`` repeats. At least ``max(2, ceil(K/100))`` coefficients are kept
+    above the cut-off to estimate the floor. With ``g = 1`` this is the white-floor rule of
+    Morelli (1995).
     """
     k_total = power.size
+    g = np.ones(k_total) if shape is None else shape
     reserve = max(2, int(np.ceil(k_total / 100)))
     k_max = k_total - reserve
-    floor = float(np.median(power[k_total // 2 :])) / _CHI2_1_MEDIAN
+    upper = slice(k_total // 2, None)
+    positive = g[upper] > 0.0
+    ratio = power[upper][positive] / g[upper][positive]
+    sigma2 = float(np.median(ratio)) / _CHI2_1_MEDIAN if ratio.size else 0.0
     seen: set[int] = set()
     k_c = k_max
     for _ in range(_MAX_ITER):
-        j = np.concatenate(([0.0], np.cumsum(power[:k_max] - 2.0 * floor)))
+        j = np.concatenate(([0.0], np.cumsum(power[:k_max] - 2.0 * sigma2 * g[:k_max])))
         k_c = int(np.argmax(j))
-        floor = float(np.mean(power[k_c:]))
+        g_sum = float(np.sum(g[k_c:]))
+        sigma2 = float(np.sum(power[k_c:])) / g_sum if g_sum > 0.0 else 0.0
         if k_c in seen:
             break
         seen.add(k_c)
-    return k_c, floor
+    return k_c, sigma2
 
 
-def _wiener_weights(power: np.ndarray, k_c: int, floor: float) -> np.ndarray:
-    """Weights ``Phi_k = S_k / (S_k + N)`` for ``k <= k_c`` and 0 above.
+def _wiener_weights(power: np.ndarray, k_c: int, floor: np.ndarray) -> np.ndarray:
+    """Weights ``Phi_k = S_k / (S_k + N_k)`` for ``k <= k_c`` and 0 above.
 
-    ``S_k = max(Pbar_k - N, 0)`` is the signal power estimated by
-    subtracting the noise floor from the locally averaged coefficient power
-    ``Pbar`` (running mean over ``w`` coefficients, ``w`` odd, about 1 % of
-    the band and at least 5; reflected at the band edges).  Hence
-    ``Phi_k = max(1 - N/Pbar_k, 0)``: ~1 where the signal dominates,
-    falling towards ~1/2 as the spectrum approaches the floor near the
+    ``S_k = max(Pbar_k - N_k, 0)`` is the signal power estimated by subtracting the noise
+    floor ``N_k`` (one value per coefficient) from the locally averaged coefficient power
+    ``Pbar`` (running mean over ``w`` coefficients, ``w`` odd, about 1 % of the band and at
+    least 5; reflected at the band edges). Hence ``Phi_k = max(1 - N_k/Pbar_k, 0)``: ~1 where
+    the signal dominates, falling towards ~1/2 as the spectrum approaches the floor near the
     automatic cut-off, and 0 above the cut-off.
     """
     k_total = power.size
     weights = np.zeros(k_total)
     if k_c == 0:
         return weights
-    if floor <= 0.0:
+    if not np.any(floor[:k_c] > 0.0):
         weights[:k_c] = 1.0
         return weights
     width = max(5, 2 * (k_total // 200) + 1)
     width = min(width, k_total if k_total % 2 else k_total - 1)
     pbar = ndimage.uniform_filter1d(power, size=width, mode="reflect")[:k_c]
-    with np.errstate(divide="ignore"):
-        weights[:k_c] = np.where(pbar > floor, 1.0 - floor / pbar, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        weights[:k_c] = np.where(pbar > floor[:k_c], 1.0 - floor[:k_c] / pbar, 0.0)
     return weights
+
+
+def _noise_shape(noise_shape, freqs: np.ndarray) -> np.ndarray | None:
+    """The floor's relative shape ``g_k`` at the sine-series frequencies (None: white)."""
+    if noise_shape is None:
+        return None
+    g = np.asarray(noise_shape(freqs) if callable(noise_shape) else noise_shape, dtype=float)
+    if g.shape != freqs.shape:
+        raise ValueError(f"noise_shape must give one value per sine coefficient ({freqs.size}), got {g.shape}")
+    if not np.all(np.isfinite(g)) or np.any(g < 0.0) or not np.any(g > 0.0):
+        raise ValueError("noise_shape must be finite, non-negative and not all zero")
+    return g
 
 
 def optimal_fourier_smoother(
@@ -218,6 +240,7 @@ def optimal_fourier_smoother(
     dt: float,
     *,
     cutoff_hz: float | None = None,
+    noise_shape: Callable[[np.ndarray], npt.ArrayLike] | npt.ArrayLike | None = None,
 ) -> FourierSmoothing:
     """Smooth a record with the optimal Fourier (sine-series Wiener) smoother.
 
@@ -231,15 +254,20 @@ def optimal_fourier_smoother(
        the interior points (:func:`scipy.fft.dst`).
     3. Noise floor and cut-off.  For white noise of variance ``sigma^2``
        every ``b_k`` gets independent noise with
-       ``E[b_k**2] = 2 sigma^2/(N-1)`` -- a flat floor ``N``.  Automatic
-       cut-off: the number of retained coefficients maximises
-       ``sum_{i<=k} (b_i**2 - 2 N)``, i.e. the point where the signal power
-       meets the floor (see :func:`_automatic_cutoff`), with ``N``
-       re-estimated as the mean of ``b_k**2`` above the cut-off.  Manual
-       cut-off: the coefficients with ``f_k <= cutoff_hz`` are retained and
-       ``N`` is the mean of ``b_k**2`` above ``cutoff_hz``.
-    4. Wiener filter ``Phi_k = S_k/(S_k + N)`` with the signal power
-       ``S_k = max(Pbar_k - N, 0)`` from the locally averaged coefficient
+       ``E[b_k**2] = 2 sigma^2/(N-1)`` -- a flat floor.  Noise that is white
+       noise passed through a linear filter of frequency response ``H``
+       (for example a numerically differentiated record) has, to the same
+       approximation, ``E[b_k**2] = 2 sigma^2 |H(f_k)|**2/(N-1)``: a floor
+       ``N_k = s g_k`` of known shape ``g_k = |H(f_k)|**2`` (``noise_shape``)
+       and unknown scale ``s``.  Automatic cut-off: the number of retained
+       coefficients maximises ``sum_{i<=k} (b_i**2 - 2 N_i)``, i.e. the point
+       where the signal power meets the floor (see
+       :func:`_automatic_cutoff`), with the scale re-estimated from the
+       coefficients above the cut-off.  Manual cut-off: the coefficients with
+       ``f_k <= cutoff_hz`` are retained and the scale comes from those above
+       ``cutoff_hz``.
+    4. Wiener filter ``Phi_k = S_k/(S_k + N_k)`` with the signal power
+       ``S_k = max(Pbar_k - N_k, 0)`` from the locally averaged coefficient
        power ``Pbar`` below the cut-off, and ``Phi_k = 0`` above it (see
        :func:`_wiener_weights`).  The same rule is used with a manual
        cut-off.
@@ -257,6 +285,15 @@ def optimal_fourier_smoother(
         Cut-off frequency set by hand.  ``None`` (default) chooses it from the
         data.  A cut-off at or above the highest frequency ``(N-2)/(2T)``
         keeps every coefficient (then ``noise_variance`` is 0).
+    noise_shape : callable or array_like, optional
+        Relative shape ``g_k`` of the noise floor: a function of the
+        frequencies ``f_k`` in Hz (``k = 1 .. N-2``) or one value per
+        coefficient, non-negative; only its shape matters.  ``None`` (default)
+        is white noise, ``g_k = 1`` (Morelli 1995).  For a record made by a
+        linear filter from a record with white noise, give the filter's power
+        gain ``|H(f)|**2``
+        (:func:`estimators.differentiation.local_derivative_noise_shape` for
+        the local polynomial derivative, seed method 3).
 
     Returns
     -------
@@ -279,10 +316,11 @@ def optimal_fourier_smoother(
     its second derivative there unless ``x''`` vanishes at the ends, and the
     end-point line carries the noise of the two end samples).  The seed paper
     recommends including 1 s of extra data at each end and discarding it
-    (:func:`estimators.differentiation.interior_mask`).  The method assumes
-    white measurement noise; strongly coloured noise (for example the noise
-    of a numerically differentiated signal) biases the floor and the
-    automatic cut-off.
+    (:func:`estimators.differentiation.interior_mask`).  Without
+    ``noise_shape`` the method assumes white measurement noise; coloured
+    noise of another shape (for example the noise of a numerically
+    differentiated signal, whose floor rises with frequency) then biases the
+    floor and the automatic cut-off.
     """
     a, dt = _validate(x, dt)
     n = a.size
@@ -291,15 +329,18 @@ def optimal_fourier_smoother(
     power = b * b
     k_total = power.size
     freqs = np.arange(1, k_total + 1) / (2.0 * span)
+    shape = _noise_shape(noise_shape, freqs)
 
     if cutoff_hz is None:
-        k_c, floor = _automatic_cutoff(power)
+        k_c, scale = _automatic_cutoff(power, shape)
     else:
         fc = float(cutoff_hz)
         if not (np.isfinite(fc) and fc > 0.0):
             raise ValueError("cutoff_hz must be a positive finite number")
         k_c = int(np.searchsorted(freqs, fc, side="right"))
-        floor = float(np.mean(power[k_c:])) if k_c < k_total else 0.0
+        g_above = float(np.sum(shape[k_c:])) if shape is not None else float(k_total - k_c)
+        scale = float(np.sum(power[k_c:])) / g_above if k_c < k_total and g_above > 0.0 else 0.0
+    floor = scale * (shape if shape is not None else np.ones(k_total))
 
     weights = _wiener_weights(power, k_c, floor)
     smoothed = line.copy()
@@ -308,7 +349,7 @@ def optimal_fourier_smoother(
     return FourierSmoothing(
         smoothed=smoothed,
         noise=noise,
-        noise_variance=0.5 * (n - 1) * floor,
+        noise_variance=0.5 * (n - 1) * float(np.mean(floor)),
         noise_sample_variance=float(np.var(noise, ddof=1)),
         cutoff_hz=float(freqs[k_c - 1]) if k_c > 0 else 0.0,
         frequencies_hz=freqs,

@@ -102,6 +102,21 @@ def test_local_derivative_sinusoid_truncation_error():
         assert abs(d[-1 - i] - w * np.cos(w * t[-1 - i])) <= bound
 
 
+def test_local_derivative_noise_shape_is_the_filter_power_gain():
+    """|H|^2 of the 5-point formula is ((sin θ + 2 sin 2θ)/(5 dt))^2, θ = 2π f dt; and it is
+    what the filter does to sinusoids (checked on a 7-point cubic too)."""
+    from estimators.differentiation import local_derivative_noise_shape
+    f = np.linspace(0.0, 0.5 / DT, 37)
+    theta = 2 * np.pi * f * DT
+    np.testing.assert_allclose(local_derivative_noise_shape(DT)(f),
+                               ((np.sin(theta) + 2 * np.sin(2 * theta)) / (5 * DT)) ** 2, rtol=1e-12, atol=1e-9)
+    t = np.arange(400) * DT
+    for fk in (0.3, 4.0, 11.0):
+        d = local_polynomial_derivative(np.sin(2 * np.pi * fk * t), DT, window=7, order=3)
+        gain = np.sqrt(local_derivative_noise_shape(DT, window=7, order=3)(np.array([fk]))[0])
+        np.testing.assert_allclose(np.abs(d[10:-10]).max(), gain, rtol=2e-3)
+
+
 @pytest.mark.parametrize(
     "kwargs", [{"window": 4}, {"window": 5, "order": 5}, {"window": 5, "order": 0}]
 )
@@ -180,6 +195,11 @@ def test_seed_fig1_experiment(capsys):
     to 10 % of the deterministic part's RMS.  Error: RMS of (estimate - true
     derivative) over the interior divided by the RMS of the true derivative
     there.  All smoothing uses the automatic cut-off, as in the seed paper.
+
+    The seed: methods 1 and 2 "similar ... averaging around 5 percent", method 3 "less
+    accurate ... occasionally". With method 3's smoother told the shape of its derivative's
+    noise floor (rising with frequency), its mean is at most twice method 1's (it was 12x
+    with a white floor assumed: 42 %).
     """
     from harness.studies import differentiation_study
     df = differentiation_study(100, seed=0, noise_to_signal=0.10, dt=DT)
@@ -191,5 +211,7 @@ def test_seed_fig1_experiment(capsys):
             f"method 1 = {mean[0]:.4f}, method 2 = {mean[1]:.4f}, method 3 = {mean[2]:.4f}; "
             f"max = {errors.max(axis=0).round(4).tolist()}"
         )
-    assert mean[0] <= 0.05 and mean[1] <= 0.05
-    assert mean[2] > mean[0] and mean[2] > mean[1]
+    assert mean[0] <= 0.04 and mean[1] <= 0.04
+    assert abs(mean[0] - mean[1]) < 0.1 * mean[0]
+    assert mean[0] < mean[2] <= 2 * mean[0]
+    assert errors[:, 2].max() > 2 * mean[2]  # "occasionally led to increased errors"
