@@ -13,7 +13,9 @@ def add_flight_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--variant", default="nominal", choices=["nominal", "exact-truth", "unstable"],
                    help="nominal; exact-truth (aerodynamics exactly linear, seed §III.C); "
                         "unstable (aero reference point moved forward)")
-    p.add_argument("--condition", default=None, help="flight condition: f16 seed-5deg (default) or alpha-7.5; 737 cruise")
+    p.add_argument("--condition", default=None,
+                   help="flight condition by name (f16: seed-5deg, the default, or alpha-7.5; 737: cruise) "
+                        "or by value, h=<ft>,V=<ft/s true airspeed> (e.g. h=10000,V=427.4)")
     p.add_argument("--maneuver", default="2-1-1-2", choices=INPUT_CHOICES,
                    help="input design (default 2-1-1-2); three-axis = de 2-1-1-2, da doublet, dr 2-1-1; "
                         "lateral = da doublet then dr 2-1-1")

@@ -146,6 +146,11 @@ def to_recording(spec: FlightSpec, hist: FlightHistory, tp: TrimPoint, truth: De
             "sim_rate_hz": hist.sim_rate_hz, "frames": hist.frames, "sample_rate_hz": hist.sample_rate_hz,
             "rates": "body rates relative to the Earth (equal to the air-relative rates in still air)",
             "cg_in": list(tp.cg_in), "aero_rp_in": list(tp.aero_rp_in),
+            # gear, flaps, speed brake and scheduled surfaces as flown (models.configuration)
+            "configuration": tp.configuration,
+            # "jsbsim" (JSBSim's trim) or "surfaces" (the project's, FCS disabled); any
+            # scheduled surface held on one side of its switch, and why (models.trim)
+            "trim_method": tp.method, "trim_held": tp.held,
             # the concealed physics and its true size (the recording's channels and
             # sensors metadata do not reveal it)
             "hidden_effects": [e.describe() for e in spec.aircraft.hidden],

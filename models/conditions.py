@@ -26,15 +26,15 @@ class FlightCondition:
     note: str = ""
 
 
-# F-16 at the seed's condition (10,000 ft, alpha near 5 deg). The JSBSim F-16 will not trim
-# for alpha between about 4.94 and 5.05 deg (427.4-428 ft/s): the leading-edge flap switches at
-# alpha = 0.0873 rad with no hysteresis (../shared/jsbsim-notes.md, confirmed here). 420 ft/s
-# trims at alpha = 5.24 deg with the flap deployed (0.262 rad), safely clear of the switch; with
-# the FCS disabled for open-loop flight the flap then stays where trim left it.
+# F-16 at the seed's condition (10,000 ft, alpha near 5 deg), clean (gear up: models.configuration).
+# 420 ft/s trims at alpha = 5.27 deg with the leading-edge flap deployed (0.262 rad), clear of
+# the flap's switch at alpha = 0.0873 rad (5.00 deg; no hysteresis, so between about 428 and
+# 429.5 ft/s the trim holds the flap: models.trim); with the FCS disabled for open-loop flight
+# the flap then stays where trim left it.
 _F16 = (
     FlightCondition("seed-5deg", 10_000.0, 420.0,
-                    "seed condition: 10,000 ft, alpha 5.24 deg (just above the LEF switch at 5.0 deg)"),
-    FlightCondition("alpha-7.5", 10_000.0, 363.6,
+                    "seed condition: 10,000 ft, alpha 5.27 deg (just above the LEF switch at 5.0 deg)"),
+    FlightCondition("alpha-7.5", 10_000.0, 364.6,
                     "second condition: 10,000 ft, alpha 7.5 deg, mid-segment of the aero tables"),
 )
 
@@ -65,8 +65,50 @@ def conditions_for(model: str) -> tuple[FlightCondition, ...]:
                          f"known aircraft: {sorted(_CONDITIONS)}") from None
 
 
+# Keys of a condition given by value, with their units and the plausible range checked.
+_CONDITION_KEYS = {"h": ("ft", -1_000.0, 100_000.0), "V": ("ft/s true airspeed", 1.0, 5_000.0)}
+
+
+def parse_condition(text: str) -> FlightCondition:
+    """A condition given by value: ``'h=10000,V=427.4'`` (pressure altitude in ft, true
+    airspeed in ft/s), wings level. Its name is the text in canonical form, so it can stand
+    wherever a condition's name does (flight specifications, caches, metadata).
+
+    Raises
+    ------
+    ValueError
+        Naming what is missing, unknown, not a number or out of range.
+    """
+    values: dict[str, float] = {}
+    for part in text.split(","):
+        key, sep, value = part.partition("=")
+        key = key.strip()
+        if not sep or key not in _CONDITION_KEYS:
+            raise ValueError(f"condition {text!r}: expected h=<ft>,V=<ft/s>, e.g. h=10000,V=427.4 "
+                             f"(unknown or malformed part {part.strip()!r})")
+        try:
+            values[key] = float(value)
+        except ValueError:
+            raise ValueError(f"condition {text!r}: {key} must be a number, not {value.strip()!r}") from None
+    for key, (unit, lo, hi) in _CONDITION_KEYS.items():
+        if key not in values:
+            raise ValueError(f"condition {text!r}: {key} is missing (expected h=<ft>,V=<ft/s>)")
+        if not lo <= values[key] <= hi:
+            raise ValueError(f"condition {text!r}: {key} = {values[key]:g} {unit} is outside {lo:g} to {hi:g}")
+    h, V = values["h"], values["V"]
+    return FlightCondition(f"h={h:g},V={V:g}", h, V, "given by value (h in ft, V in ft/s true airspeed)")
+
+
+def is_condition_value(name: str | None) -> bool:
+    """Whether ``name`` gives a condition by value (``h=...,V=...``) rather than by name."""
+    return name is not None and "=" in name
+
+
 def condition_for(model: str, name: str | None = None) -> FlightCondition:
-    """The named condition of ``model`` (its default when ``name`` is None)."""
+    """The condition of ``model`` called ``name`` (its default when ``name`` is None), or the
+    condition ``name`` gives by value (``'h=10000,V=427.4'``, any aircraft)."""
+    if is_condition_value(name):
+        return parse_condition(name)
     conds = conditions_for(model)
     if name is None:
         return conds[0]

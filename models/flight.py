@@ -220,6 +220,9 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     channels = {"t_s": np.arange(n_samples) / sample_rate_hz}
     for i, col in enumerate(state_cols):
         channels[col] = out[:, i]
+    # JSBSim's heading lies in [0, 2*pi): a yaw through north would jump by 2*pi. Recorded
+    # continuous, as a heading gyro's integrated output is.
+    channels["psi_rad"] = np.unwrap(channels["psi_rad"])
     j = len(state_cols)
     for i, col in enumerate(surf_cols):
         channels[col] = out[:, j + i]

@@ -1,12 +1,20 @@
 """Trimming an aircraft at a named flight condition."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+import contextlib
+import math
+import os
+import sys
+from dataclasses import asdict, dataclass, field
 
 import jsbsim
+import numpy as np
+from scipy.optimize import least_squares
 
-from models.aircraft import TRIM_MOMENT_PROPERTIES, Aircraft, is_turboprop, place_reference_point
+from models.aircraft import TRIM_MOMENT_PROPERTIES, Aircraft, is_turboprop, model_xml, place_reference_point
 from models.conditions import FlightCondition
+from models.configuration import (SCHEDULED_SURFACES, command_configuration, configuration_record,
+                                  cruise_configuration, place_configuration)
 
 G0_FPS2 = 32.17404855643  # standard gravity, ft/s^2 (9.80665 m/s^2)
 
@@ -20,7 +28,11 @@ class TrimPoint:
     """The equilibrium an aircraft was trimmed to, with what is needed to normalise.
 
     Angles in rad, speeds in ft/s, rates zero. ``Ixz_slugft2`` uses the seed's sign
-    convention (Eqs. 3-5; JSBSim's inertia matrix stores its negative).
+    convention (Eqs. 3-5; JSBSim's inertia matrix stores its negative). ``configuration``
+    is the cruise configuration flown (:mod:`models.configuration`); ``held`` names any
+    scheduled surface held on one side of its switch because the schedule leaves no
+    equilibrium there (empty otherwise); ``method`` is ``'jsbsim'`` (JSBSim's own trim) or
+    ``'surfaces'`` (the project's trim with the FCS disabled, :func:`trim_surfaces`).
     """
 
     condition: str
@@ -48,6 +60,9 @@ class TrimPoint:
     cbar_ft: float
     cg_in: tuple[float, float, float]
     aero_rp_in: tuple[float, float, float]
+    configuration: dict = field(default_factory=dict)
+    held: dict = field(default_factory=dict)
+    method: str = "jsbsim"
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -69,7 +84,9 @@ def set_initial_condition(fdm: jsbsim.FGFDMExec, h_ft: float, V_fps: float) -> N
     fdm["ic/r-rad_sec"] = 0.0
 
 
-def read_trim_point(fdm: jsbsim.FGFDMExec, condition: str, surfaces: dict[str, str]) -> TrimPoint:
+def read_trim_point(fdm: jsbsim.FGFDMExec, condition: str, surfaces: dict[str, str], *,
+                    configuration: dict | None = None, held: dict | None = None,
+                    method: str = "jsbsim") -> TrimPoint:
     """Read the current state of a trimmed instance as a :class:`TrimPoint`."""
     thrust = fdm["forces/fbx-prop-lbs"]
     return TrimPoint(
@@ -88,17 +105,27 @@ def read_trim_point(fdm: jsbsim.FGFDMExec, condition: str, surfaces: dict[str, s
         S_ft2=fdm["metrics/Sw-sqft"], b_ft=fdm["metrics/bw-ft"], cbar_ft=fdm["metrics/cbarw-ft"],
         cg_in=tuple(fdm[f"inertia/cg-{a}-in"] for a in "xyz"),
         aero_rp_in=tuple(fdm[f"metrics/aero-rp-{a}-in"] for a in "xyz"),
+        configuration=dict(configuration or {}), held=dict(held or {}), method=method,
     )
 
 
 def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) -> TrimPoint:
-    """Trim ``fdm`` (freshly loaded) wings-level at ``condition`` and freeze its mass.
+    """Trim ``fdm`` (freshly loaded) wings-level at ``condition`` in cruise configuration and
+    freeze its mass.
 
-    Longitudinal trim (``do_trim(0)``: throttle, stabilator, α) with the engine running,
-    which is all a symmetric aircraft needs wings level; if the lateral accelerations are not
-    then zero (an asymmetric aircraft or variant) the full six-axis trim (``do_trim(1)``)
-    follows. The aircraft's reference-point rule is applied before trimming. Fuel is frozen
-    afterwards so mass and c.g. stay put.
+    The aircraft is first put into its cruise configuration (:mod:`models.configuration`:
+    retractable gear up and locked, flaps up, speed brake closed). Longitudinal trim
+    (``do_trim(0)``: throttle, stabilator, α) with the engine running is all a symmetric
+    aircraft needs wings level; if the lateral accelerations are not then zero (an
+    asymmetric aircraft or variant) the full six-axis trim (``do_trim(1)``) follows. The
+    aircraft's reference-point rule is applied before trimming. Fuel is frozen afterwards so
+    mass and c.g. stay put.
+
+    Where JSBSim's trim fails, :func:`trim_surfaces` solves for the equilibrium itself with
+    the FCS disabled and any discontinuously scheduled surface (the F-16's leading-edge flap)
+    at each of its positions: a position consistent with its schedule is taken; where none
+    is (near a switch with no hysteresis, the F-16 between α ≈ 4.99° and 5.02°), the surface
+    is held on one side of the switch and :attr:`TrimPoint.held` says so.
 
     Turboprops (:func:`models.aircraft.is_turboprop`: the DHC6) deliver no shaft power while JSBSim trims,
     so they are re-trimmed with their propeller torque applied as external moments
@@ -108,37 +135,202 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     Raises
     ------
     TrimError
-        Naming the aircraft, the condition and, for the F-16 near alpha = 5 deg, the
-        leading-edge-flap switch that makes trim impossible there.
+        Naming the aircraft, the condition and why no equilibrium exists there (not enough
+        thrust, not enough lift or pitch control within the surfaces' travel).
     """
     set_initial_condition(fdm, condition.h_ft, condition.V_fps)
+    config = cruise_configuration(model_xml(aircraft.model))
+    written = command_configuration(fdm, config)
     fdm["propulsion/set-running"] = -1
     fdm.run_ic()
+    written.update(place_configuration(fdm, config))
     if place_reference_point(fdm, aircraft):
         fdm.run_ic()
     turboprop = is_turboprop(aircraft.model)
     # The propeller-torque re-trim needs the stand-in moments (the DHC6 copy has them).
     torque = turboprop and fdm.get_property_manager().hasNode(next(iter(TRIM_MOMENT_PROPERTIES.values())))
+    held: dict = {}
+    method = "jsbsim"
     try:
-        fdm.do_trim(0)
-        lateral = max(abs(fdm["accelerations/pdot-rad_sec2"]), abs(fdm["accelerations/rdot-rad_sec2"]),
-                      abs(fdm["accelerations/vdot-ft_sec2"]))
-        if lateral > 1e-6:
-            fdm.do_trim(1)
-        if torque:
-            _trim_with_propeller_torque(fdm)
+        with _quiet_stdout():
+            fdm.do_trim(0)
+            lateral = max(abs(fdm["accelerations/pdot-rad_sec2"]), abs(fdm["accelerations/rdot-rad_sec2"]),
+                          abs(fdm["accelerations/vdot-ft_sec2"]))
+            if lateral > 1e-6:
+                fdm.do_trim(1)
+            if torque:
+                _trim_with_propeller_torque(fdm)
     except jsbsim.TrimFailureError as exc:
-        hint = ""
-        if aircraft.model == "f16" and 420.0 < condition.V_fps < 432.0 and abs(condition.h_ft - 10_000) < 2_000:
-            hint = (" The F-16 cannot trim for alpha between about 4.94 and 5.05 deg: its "
-                    "leading-edge flap switches at alpha = 0.0873 rad with no hysteresis. "
-                    "Choose a speed outside about 427-429 ft/s.")
-        raise TrimError(f"trim failed for {aircraft.label} at {condition.name!r} "
-                        f"(h = {condition.h_ft:.0f} ft, V = {condition.V_fps:.1f} ft/s): {exc}.{hint}") from exc
+        if turboprop:
+            raise TrimError(_where(aircraft, condition) + f": JSBSim's trim failed ({exc}) and a "
+                            "turboprop is trimmed by JSBSim only") from exc
+        held = trim_surfaces(fdm, aircraft, condition)
+        method = "surfaces"
     fdm["propulsion/fuel_freeze"] = 1
     if turboprop:
         settle_engines(fdm)
-    return read_trim_point(fdm, condition.name, aircraft.surfaces)
+    return read_trim_point(fdm, condition.name, aircraft.surfaces,
+                           configuration=configuration_record(fdm, config, written), held=held, method=method)
+
+
+def _where(aircraft: Aircraft, condition: FlightCondition) -> str:
+    return (f"{aircraft.label} cannot trim at {condition.name!r} "
+            f"(h = {condition.h_ft:.0f} ft, V = {condition.V_fps:.1f} ft/s true airspeed)")
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Silence what JSBSim's C++ trim prints to the process's standard output (e.g. "Sorry,
+    wdot doesn't appear to be trimmable"): the failure is reported by the exception."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(fd)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), fd)
+            yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
+# Bounds of the surface trim's unknowns: alpha (rad), stabilator (rad), throttle (0-1).
+_ALPHA_BOUNDS = (-0.3, 0.8)
+_DE_BOUNDS = (-0.5, 0.5)
+_TRIM_TOL = 1e-8  # residual (udot/g, wdot/g, qdot in rad/s^2) accepted as equilibrium
+
+
+@dataclass(frozen=True)
+class _Equilibrium:
+    x: np.ndarray  # alpha, de, throttle
+    residual: float
+    at_bound: tuple[str, ...]
+
+
+def _engines(fdm: jsbsim.FGFDMExec) -> int:
+    return int(fdm.get_propulsion().get_num_engines())
+
+
+def _level_residual(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition,
+                    hold: dict[str, float], x: np.ndarray) -> list[float]:
+    """Put the instance at α, stabilator, throttle = ``x`` in wings-level flight (γ = 0,
+    β = 0, rates zero, ``hold`` surfaces written) and return u̇/g, ẇ/g and q̇ (rad/s²)."""
+    alpha, de, throttle = (float(v) for v in x)
+    set_initial_condition(fdm, condition.h_ft, condition.V_fps)
+    fdm["ic/alpha-rad"] = alpha
+    fdm["ic/theta-rad"] = alpha
+    fdm[aircraft.surfaces["de"]] = de
+    for i in range(_engines(fdm)):
+        fdm[f"fcs/throttle-pos-norm[{i}]"] = throttle
+    for prop, v in hold.items():
+        fdm[prop] = v
+    fdm.run_ic()
+    return [fdm["accelerations/udot-ft_sec2"] / G0_FPS2, fdm["accelerations/wdot-ft_sec2"] / G0_FPS2,
+            fdm["accelerations/qdot-rad_sec2"]]
+
+
+def _solve_level(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition,
+                 hold: dict[str, float]) -> _Equilibrium:
+    """Wings-level, 1-g equilibrium with the FCS disabled: the α, stabilator and throttle
+    that zero u̇, ẇ and q̇ (bounded least squares on ``run_ic`` evaluations,
+    :func:`_level_residual`). The instance is left at the solution."""
+    qS = 0.5 * fdm["atmosphere/rho-slugs_ft3"] * condition.V_fps ** 2 * fdm["metrics/Sw-sqft"]
+    # Start from the alpha a lift slope of 4.5 per rad would need (a typical wing's).
+    alpha0 = float(np.clip(fdm["inertia/mass-slugs"] * G0_FPS2 / max(qS, 1e-9) / 4.5, 0.0, 0.5))
+    lo = [_ALPHA_BOUNDS[0], _DE_BOUNDS[0], 0.0]
+    hi = [_ALPHA_BOUNDS[1], _DE_BOUNDS[1], 1.0]
+    sol = least_squares(lambda x: _level_residual(fdm, aircraft, condition, hold, x), [alpha0, 0.0, 0.5],
+                        bounds=(lo, hi), xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200)
+    _level_residual(fdm, aircraft, condition, hold, sol.x)
+    names = ("alpha", "stabilator", "throttle")
+    at_bound = tuple(n for n, v, a, b in zip(names, sol.x, lo, hi) if min(v - a, b - v) < 1e-6)
+    return _Equilibrium(sol.x, float(np.max(np.abs(sol.fun))), at_bound)
+
+
+def _scheduled_positions(fdm: jsbsim.FGFDMExec, surfaces: tuple[str, ...]) -> dict[str, float]:
+    """What the FCS schedules the ``surfaces`` to at the instance's current state (one
+    ``run_ic`` with the FCS enabled; the caller re-evaluates with it disabled)."""
+    fdm["simulation/models/FGFCS/enabled"] = 1
+    fdm.run_ic()
+    out = {s: float(fdm[s]) for s in surfaces}
+    fdm["simulation/models/FGFCS/enabled"] = 0
+    return out
+
+
+def trim_surfaces(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) -> dict:
+    """Trim with the FCS disabled, holding discontinuously scheduled surfaces where needed.
+
+    For each combination of the aircraft's scheduled-surface positions
+    (:data:`models.configuration.SCHEDULED_SURFACES`), the equilibrium is solved by
+    :func:`_solve_level`; the first whose positions are the ones the schedule gives at that
+    equilibrium is taken. If none is consistent (the schedule switches with no hysteresis
+    between two equilibria), the first converged one is kept with its surface held, and the
+    returned dict says which surface, where it is held, what the schedule would set there
+    and why. The instance is left at the equilibrium with the FCS disabled.
+
+    Returns
+    -------
+    dict
+        ``{}`` when nothing had to be held, else ``{surface: {"held", "scheduled", "alpha_rad",
+        "reason"}}``.
+
+    Raises
+    ------
+    TrimError
+        When no equilibrium exists, naming the condition and what runs out (the variable at
+        its limit: thrust, lift or stabilator travel).
+    """
+    fdm["simulation/models/FGFCS/enabled"] = 0
+    schedule = SCHEDULED_SURFACES.get(aircraft.name, {})
+    candidates = _position_combinations(schedule)
+    converged: list[tuple[dict[str, float], _Equilibrium, dict[str, float]]] = []
+    last = None
+    for hold in candidates:
+        eq = _solve_level(fdm, aircraft, condition, hold)
+        last = eq
+        if eq.residual > _TRIM_TOL:
+            continue
+        scheduled = _scheduled_positions(fdm, tuple(hold)) if hold else {}
+        if all(abs(scheduled[s] - v) < 1e-9 for s, v in hold.items()):
+            _level_residual(fdm, aircraft, condition, hold, eq.x)
+            return {}
+        converged.append((hold, eq, scheduled))
+    if converged:
+        hold, eq, scheduled = converged[0]
+        _level_residual(fdm, aircraft, condition, hold, eq.x)
+        return {s: {"held": v, "scheduled": scheduled[s], "alpha_rad": float(eq.x[0]),
+                    "reason": (f"no equilibrium is consistent with the schedule of {s} here (it switches "
+                               f"with no hysteresis): trimmed with it held at {v:g}, where the schedule "
+                               f"would set {scheduled[s]:g} at the trimmed alpha = "
+                               f"{math.degrees(eq.x[0]):.3f} deg")}
+                for s, v in hold.items()}
+    raise TrimError(_where(aircraft, condition) + ": " + _why_not(last))
+
+
+def _position_combinations(schedule: dict[str, tuple[float, ...]]) -> list[dict[str, float]]:
+    combos: list[dict[str, float]] = [{}]
+    for surface, positions in schedule.items():
+        combos = [{**c, surface: p} for c in combos for p in positions]
+    return combos
+
+
+def _why_not(eq: _Equilibrium | None) -> str:
+    """Why the level-flight equilibrium does not exist, from the variables at their limits."""
+    if eq is None:
+        return "no equilibrium found"
+    causes = {"throttle": "full throttle does not give the thrust level flight needs here",
+              "alpha": "the lift level flight needs is beyond what the aerodynamic tables give "
+                       f"within alpha {math.degrees(_ALPHA_BOUNDS[0]):.0f} to {math.degrees(_ALPHA_BOUNDS[1]):.0f} deg",
+              "stabilator": "the stabilator's travel cannot balance the pitching moment"}
+    named = [causes[n] for n in eq.at_bound]
+    detail = "; ".join(named) if named else "the equations of level flight have no solution"
+    return (f"no level-flight equilibrium ({detail}; closest: alpha = {math.degrees(eq.x[0]):.2f} deg, "
+            f"stabilator = {math.degrees(eq.x[1]):.2f} deg, throttle = {eq.x[2]:.2f}, residual "
+            f"{eq.residual:.2g})")
 
 
 _PROP_MOMENTS = ("moments/l-prop-lbsft", "moments/m-prop-lbsft", "moments/n-prop-lbsft")
