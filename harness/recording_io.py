@@ -21,9 +21,9 @@ written one after the other (data first).
 from __future__ import annotations
 
 import csv
-import io
 import json
 import math
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
@@ -31,10 +31,20 @@ from typing import IO, Any
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from harness.atomic import write_atomic, write_text_atomic
-from maneuvers.recording import Recording, RecordingError, to_canonical
+from maneuvers.recording import (
+    ROW_CONVENTION,
+    Recording,
+    RecordingError,
+    canonical_names,
+    convert_in_place,
+    frame_from_columns,
+    row_label,
+)
 
 __all__ = ["PARQUET_META_KEY", "meta_path_for", "read_recording", "write_recording"]
 
@@ -116,58 +126,193 @@ def _parse_meta(text: str, source: str) -> dict[str, Any]:
 # --------------------------------------------------------------------------------------
 
 
+_WRITE_CHUNK_ROWS = 65_536
+
+
 def _csv_lines(data: pd.DataFrame) -> Iterator[str]:
+    """The CSV text in pieces of at most :data:`_WRITE_CHUNK_ROWS` rows (memory stays bounded)."""
     yield ",".join(data.columns) + "\n"
-    columns = [[repr(v) for v in data[c].to_numpy(dtype=np.float64).tolist()] for c in data.columns]
-    for row in zip(*columns):
-        yield ",".join(row) + "\n"
+    arrays = [data[c].to_numpy(dtype=np.float64) for c in data.columns]
+    for start in range(0, len(data), _WRITE_CHUNK_ROWS):
+        columns = [[repr(v) for v in a[start:start + _WRITE_CHUNK_ROWS].tolist()] for a in arrays]
+        yield "".join(",".join(row) + "\n" for row in zip(*columns))
 
 
 def _write_csv_body(data: pd.DataFrame, fh: IO[bytes]) -> None:
-    fh.write("".join(_csv_lines(data)).encode("utf-8"))
+    for piece in _csv_lines(data):
+        fh.write(piece.encode("utf-8"))
 
 
-def _read_csv_frame(path: Path) -> pd.DataFrame:
-    """Read a recording CSV exactly (Python's correctly rounded float parser)."""
+def _read_header(path: Path) -> list[str]:
+    """The header row (file line 1), decoded as UTF-8 (a BOM is skipped), duplicates refused."""
     source = str(path)
-    text = path.read_text(encoding="utf-8-sig")
-    rows = list(csv.reader(io.StringIO(text)))
-    while rows and not rows[-1]:  # trailing blank lines
-        rows.pop()
-    if not rows:
-        raise RecordingError("file is empty; expected a header row", source=source, key="header",
+    with path.open("rb") as fh:
+        raw = fh.readline()
+        if not raw.strip() and not fh.read(1):
+            raise RecordingError("file is empty; expected a header row", source=source, key="header",
+                                 rule="empty-file")
+    text = _decode_utf8(raw.removeprefix(b"\xef\xbb\xbf"), source, "header (file line 1)")
+    header = [h.strip() for h in next(csv.reader([text.rstrip("\r\n")]), [])]
+    if not any(header):
+        raise RecordingError("the first line is blank; expected a header row", source=source, key="header",
                              rule="empty-file")
-    header = [h.strip() for h in rows[0]]
     seen: set[str] = set()
     for h in header:
         if h in seen:
             raise RecordingError("column appears twice in the header", source=source,
                                  key=f"column {h!r}", rule="duplicate-quantity")
         seen.add(h)
-    body = rows[1:]
-    for i, row in enumerate(body):
-        if len(row) != len(header):
-            raise RecordingError(
-                f"line {i + 2} has {len(row)} field(s), the header has {len(header)} "
-                "(ragged row: column lengths do not match)",
-                source=source, key=f"line {i + 2}", rule="length-mismatch",
-            )
-    columns: dict[str, np.ndarray] = {}
-    for j, name in enumerate(header):
-        cells = [row[j] for row in body]
+    return header
+
+
+def _decode_utf8(raw: bytes, source: str, where: str) -> str:
+    """``raw`` as text, or an error naming the line and column of the first byte that is not UTF-8."""
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise RecordingError(
+            f"not valid UTF-8: byte 0x{raw[exc.start]:02x} at line {line}, column {column} of the {where} "
+            "(Latin-1 or another encoding?); save the file as UTF-8",
+            source=source, key=where, rule="bad-encoding",
+        ) from None
+
+
+class _InvalidRows:
+    """Invalid-row handler for pyarrow's CSV reader: remembers the first ragged row."""
+
+    def __init__(self) -> None:
+        self.first: tuple[int | None, int, int] | None = None
+
+    def __call__(self, row: Any) -> str:
+        if self.first is None:
+            self.first = (row.number, row.actual_columns, row.expected_columns)
+        return "error"
+
+
+def _arrow_csv(path: Path, header: list[str], *, threads: bool = True, handler: Any = None,
+               types: Any = None, include: list[str] | None = None) -> pa.Table:
+    """The body of a recording CSV as an Arrow table (header given, blank lines kept as null rows)."""
+    column_type = types or pa.float64()
+    return pacsv.read_csv(
+        path,
+        read_options=pacsv.ReadOptions(column_names=header, skip_rows=1, use_threads=threads,
+                                       block_size=1 << 24),
+        parse_options=pacsv.ParseOptions(ignore_empty_lines=False, invalid_row_handler=handler),
+        convert_options=pacsv.ConvertOptions(
+            column_types={h: column_type for h in (include or header)}, include_columns=include,
+            null_values=[""], strings_can_be_null=False, quoted_strings_can_be_null=False, check_utf8=False),
+        memory_pool=pa.system_memory_pool(),
+    )
+
+
+def _line_text(row: int) -> str:
+    """``'row 3 (data rows counted from 1; file line 4)'`` for the 1-based data row ``row``."""
+    return f"row {row} ({ROW_CONVENTION}; file line {row + 1})"
+
+
+def _ragged_row_error(path: Path, header: list[str], first: tuple[int | None, int, int]) -> RecordingError:
+    number, actual, expected = first
+    if number is None or number < 0:  # the threaded reader does not count lines: find it again
+        handler = _InvalidRows()
         try:
-            columns[name] = np.fromiter(map(float, cells), dtype=np.float64, count=len(cells))
-        except ValueError:
-            for i, cell in enumerate(cells):
-                try:
-                    float(cell)
-                except ValueError:
-                    raise RecordingError(
-                        f"cannot read {cell!r} on line {i + 2} as a number",
-                        source=source, key=f"column {name!r}", rule="non-numeric",
-                    ) from None
-            raise
-    return pd.DataFrame(columns, index=pd.RangeIndex(len(body)))
+            _arrow_csv(path, header, threads=False, handler=handler)
+        except pa.ArrowInvalid:
+            pass
+        if handler.first is not None:
+            number, actual, expected = handler.first
+    where = _line_text(number - 1) if number and number > 0 else "a row"
+    return RecordingError(
+        f"{where} has {actual} field(s), the header has {expected} (ragged row: column lengths do not match)",
+        source=str(path), key=f"line {number}" if number else "rows", rule="length-mismatch",
+    )
+
+
+_NUMBER_RE = r"^\s*[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|nan|inf|infinity)\s*$"
+
+
+def _non_numeric_error(path: Path, header: list[str], message: str) -> RecordingError:
+    """Name the column and row of the first cell the reader could not take as a number."""
+    match = re.search(r"column #(\d+)", message)
+    name = header[int(match.group(1))] if match and int(match.group(1)) < len(header) else None
+    if name is None:
+        return RecordingError(f"cannot read the file as numbers: {message}", source=str(path), key="data",
+                              rule="non-numeric")
+    cells = _arrow_csv(path, header, types=pa.binary(), include=[name]).column(0)
+    ok = pc.match_substring_regex(cells, _NUMBER_RE, ignore_case=True)
+    index = pc.index(ok, False).as_py()
+    if index < 0:
+        return RecordingError(f"cannot read a cell as a number: {message}", source=str(path),
+                              key=f"column {name!r}", rule="non-numeric")
+    cell = cells[index].as_py().decode("utf-8", errors="backslashreplace")
+    return RecordingError(
+        f"cannot read {cell!r} on {_line_text(index + 1)} as a number",
+        source=str(path), key=f"column {name!r}", rule="non-numeric",
+    )
+
+
+def _drop_trailing_blank_rows(table: pa.Table, path: Path) -> pa.Table:
+    """Blank lines at the end are ignored; a blank line among the data is refused."""
+    if table.num_columns == 0 or table.column(0).null_count == 0:
+        return table
+    empty = np.asarray(pc.is_null(table.column(0)))
+    for column in table.columns[1:]:
+        empty &= np.asarray(pc.is_null(column))
+    blank = np.flatnonzero(empty)
+    if blank.size == 0:
+        return table
+    trailing = table.num_rows - blank.size
+    if blank[0] < trailing:
+        row = int(blank[0]) + 1
+        raise RecordingError(f"{_line_text(row)} is blank (a blank line among the data)", source=str(path),
+                             key=f"line {row + 1}", rule="length-mismatch")
+    return table.slice(0, trailing)
+
+
+def _read_csv_table(path: Path) -> pa.Table:
+    """Read a recording CSV with pyarrow (columnar, float64, correctly rounded parsing)."""
+    if path.stat().st_size == 0:
+        raise RecordingError("file is empty; expected a header row", source=str(path), key="header",
+                             rule="empty-file")
+    header = _read_header(path)
+    handler = _InvalidRows()
+    try:
+        table = _arrow_csv(path, header, handler=handler)
+    except pa.ArrowInvalid as exc:
+        if handler.first is not None:
+            raise _ragged_row_error(path, header, handler.first) from None
+        raise _non_numeric_error(path, header, str(exc)) from None
+    return _drop_trailing_blank_rows(table, path)
+
+
+def _arrow_columns(table: pa.Table, source: str) -> dict[str, np.ndarray]:
+    """Float64 NumPy columns of ``table``, each Arrow column released once copied (peak memory
+    is the table plus one column, not twice the table)."""
+    names = list(table.column_names)
+    arrow = list(table.columns)
+    del table
+    out: dict[str, np.ndarray] = {}
+    for i, name in enumerate(names):
+        column, arrow[i] = arrow[i], None
+        if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type)):
+            raise RecordingError(f"values must be numbers, the column holds {column.type}", source=source,
+                                 key=f"column {name!r}", rule="non-numeric")
+        if column.null_count:
+            row = pc.index(pc.is_null(column), True).as_py() + 1
+            raise RecordingError(f"empty value at {row_label(row - 1)}", source=source,
+                                 key=f"column {name!r}", rule="non-numeric")
+        values = column.to_numpy() if column.num_chunks != 1 else np.array(column.chunk(0).to_numpy())
+        out[name] = values.astype(np.float64, copy=False)
+        del column
+    return out
+
+
+def _frame_from_table(table: pa.Table, source: str) -> pd.DataFrame:
+    n = table.num_rows
+    names = list(table.column_names)
+    targets = canonical_names(names, source)  # names are checked before any data are converted
+    return frame_from_columns(convert_in_place(_arrow_columns(table, source), targets), n)
 
 
 # --------------------------------------------------------------------------------------
@@ -182,17 +327,21 @@ def _write_parquet_body(data: pd.DataFrame, meta_json: str, fh: IO[bytes]) -> No
     pq.write_table(table.replace_schema_metadata(metadata), fh)
 
 
-def _read_parquet(path: Path) -> tuple[pd.DataFrame, dict[str, Any]]:
+def _read_parquet(path: Path) -> tuple[pa.Table, dict[str, Any]]:
     source = str(path)
-    table = pq.read_table(path)
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise RecordingError(f"not a readable Parquet file ({' '.join(str(exc).split())[:200]})", source=source,
+                             key="file", rule="bad-parquet") from None
     metadata = table.schema.metadata or {}
     if PARQUET_META_KEY not in metadata:
         raise RecordingError(
             f"Parquet schema metadata has no {PARQUET_META_KEY.decode()!r} entry",
             source=source, key="meta", rule="missing-meta",
         )
-    meta = _parse_meta(metadata[PARQUET_META_KEY].decode("utf-8"), source)
-    return table.to_pandas(), meta
+    meta_text = _decode_utf8(metadata[PARQUET_META_KEY], source, "embedded metadata")
+    return table.replace_schema_metadata(None), _parse_meta(meta_text, source)
 
 
 # --------------------------------------------------------------------------------------
@@ -270,8 +419,7 @@ def read_recording(path: str | Path) -> Recording:
             f"cannot read {path.suffix!r} files; expected '.csv', '.parquet' or '.mat'",
             source=source, key="file suffix", rule="unknown-file-type",
         )
-    if not path.is_file():
-        raise FileNotFoundError(f"{source}: no such recording file")
+    _check_input_file(path)
     if suffix == ".mat":
         from harness.sidpac import import_sidpac  # local import: scipy.io only when needed
 
@@ -283,8 +431,21 @@ def read_recording(path: str | Path) -> Recording:
                 f"metadata file {str(meta_path)!r} is missing (expected beside the CSV)",
                 source=source, key=str(meta_path), rule="missing-meta-file",
             )
-        meta = _parse_meta(meta_path.read_text(encoding="utf-8"), str(meta_path))
-        frame = _read_csv_frame(path)
+        meta = _parse_meta(_decode_utf8(meta_path.read_bytes(), str(meta_path), "metadata"), str(meta_path))
+        table = _read_csv_table(path)
     else:
-        frame, meta = _read_parquet(path)
-    return Recording(to_canonical(frame, source), meta, name=path.stem).validate(source)
+        table, meta = _read_parquet(path)
+    n = table.num_rows
+    frame = _frame_from_table(table, source)
+    del table
+    if n != len(frame):  # pragma: no cover - defensive
+        raise RuntimeError("row count changed while converting")
+    return Recording(frame, meta, name=path.stem).validate(source)
+
+
+def _check_input_file(path: Path) -> None:
+    """A missing file or a folder is refused naming it."""
+    if path.is_dir():
+        raise RecordingError("is a folder, not a recording file", source=str(path), key="file", rule="not-a-file")
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such recording file")

@@ -58,7 +58,13 @@ __all__ = [
     "ChannelSpec",
     "Recording",
     "RecordingError",
+    "PHYSICAL_LIMITS",
+    "ROW_CONVENTION",
+    "canonical_names",
+    "convert_in_place",
+    "frame_from_columns",
     "parse_column",
+    "row_label",
     "to_canonical",
 ]
 
@@ -157,6 +163,21 @@ class RecordingError(ValueError):
 
 def _col(name: object) -> str:
     return f"column {name!r}"
+
+
+ROW_CONVENTION = "data rows counted from 1"
+"""How every message numbers samples: the first sample (the line after a CSV's header) is row 1."""
+
+
+def row_label(index: int) -> str:
+    """``'row 42 (data rows counted from 1)'`` for the sample at 0-based ``index``."""
+    return f"row {int(index) + 1} ({ROW_CONVENTION})"
+
+
+def _did_you_mean(word: str, known: tuple[str, ...] | list[str]) -> str:
+    import difflib
+    close = difflib.get_close_matches(word, list(known), n=1)
+    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def _metakey(*path: str) -> str:
@@ -332,7 +353,7 @@ def _as_float64(values: Any, name: str, source: str | None) -> np.ndarray:
     for row, v in enumerate(arr.ravel().tolist()):
         if not _is_real(v):
             raise RecordingError(
-                f"non-numeric value {v!r} at row {row}",
+                f"non-numeric value {v!r} at {row_label(row)}",
                 source=source, key=_col(name), rule="non-numeric",
             )
     return np.array([float(v) for v in arr.ravel().tolist()], dtype=np.float64)
@@ -365,9 +386,24 @@ def to_canonical(df: pd.DataFrame, source: str | None = None) -> pd.DataFrame:
     """
     if not isinstance(df, pd.DataFrame):
         raise TypeError(f"to_canonical expects a pandas.DataFrame, got {type(df).__name__}")
-    out: dict[str, np.ndarray] = {}
+    names = list(df.columns)
+    targets = canonical_names(names, source)
+    columns = {name: _as_float64(df.iloc[:, position].to_numpy(), name, source)
+               for position, name in enumerate(names)}
+    return frame_from_columns(convert_in_place(columns, targets), len(df))
+
+
+def canonical_names(names: list[Any], source: str | None = None) -> dict[Any, tuple[str, float]]:
+    """Input column name -> (canonical column name, factor), refusing what the format does not allow.
+
+    Raises
+    ------
+    RecordingError
+        For an unparseable column name, an unknown unit or two columns of the same quantity.
+    """
+    out: dict[Any, tuple[str, float]] = {}
     seen: dict[str, str] = {}
-    for position, name in enumerate(df.columns):
+    for name in names:
         quantity, target, factor = _target_name(name, source)
         if quantity in seen:
             raise RecordingError(
@@ -375,13 +411,28 @@ def to_canonical(df: pd.DataFrame, source: str | None = None) -> pd.DataFrame:
                 source=source, key=_col(name), rule="duplicate-quantity",
             )
         seen[quantity] = name
-        values = _as_float64(df.iloc[:, position].to_numpy(), name, source)
+        out[name] = (target, factor)
+    return out
+
+
+def convert_in_place(columns: dict[Any, np.ndarray], targets: dict[Any, tuple[str, float]]) -> dict[str, np.ndarray]:
+    """Rename and scale float64 ``columns`` (which the caller gives up: scaled in place, no copy)
+    to canonical units; ``t_s`` first, the others in input order."""
+    out: dict[str, np.ndarray] = {}
+    for name in list(columns):
+        target, factor = targets[name]
+        values = columns.pop(name)
         if factor != 1.0:
-            values = values * factor
+            np.multiply(values, factor, out=values)  # the same bits as ``values * factor``
         out[target] = values
     time_col = CHANNELS["t"].column
     order = ([time_col] if time_col in out else []) + [c for c in out if c != time_col]
-    return pd.DataFrame({c: out[c] for c in order}, index=pd.RangeIndex(len(df)))
+    return {c: out[c] for c in order}
+
+
+def frame_from_columns(columns: dict[str, np.ndarray], n: int) -> pd.DataFrame:
+    """A table over ``columns`` without copying them (one block per column)."""
+    return pd.DataFrame(columns, index=pd.RangeIndex(n), copy=False)
 
 
 # --------------------------------------------------------------------------------------
@@ -395,6 +446,44 @@ def _is_real(x: Any) -> bool:
 
 def _finite_real(x: Any) -> bool:
     return _is_real(x) and math.isfinite(float(x))
+
+
+def _refuse_unknown_keys(table: dict, known: tuple[str, ...], src: str, where: str) -> None:
+    for key in table:
+        if key not in known:
+            raise RecordingError(
+                f"unknown key; known keys: {', '.join(known)}{_did_you_mean(str(key), known)}",
+                source=src, key=_metakey(where, str(key)), rule="unknown-key",
+            )
+
+
+_PI = math.pi
+PHYSICAL_LIMITS: Mapping[str, tuple[float, float, bool, str]] = MappingProxyType({
+    # canonical column: (low, high, low bound excluded, why); generous, only the impossible is refused
+    "V_fps": (0.0, 3.0e4, True, "a true airspeed is positive and below 30,000 ft/s"),
+    "qbar_psf": (0.0, 1.0e5, True, "a dynamic pressure is positive (in flight) and below 100,000 psf"),
+    "alpha_rad": (-_PI, _PI, False, "an air angle lies within +-pi rad"),
+    "beta_rad": (-_PI, _PI, False, "an air angle lies within +-pi rad"),
+    "theta_rad": (-_PI, _PI, False, "a pitch angle lies within +-pi rad"),
+    "phi_rad": (-1.0e3, 1.0e3, False, "a bank angle (even unwrapped) lies within +-1000 rad"),
+    "psi_rad": (-1.0e3, 1.0e3, False, "a heading (even unwrapped) lies within +-1000 rad"),
+    "p_rps": (-50.0, 50.0, False, "a body rate lies within +-50 rad/s"),
+    "q_rps": (-50.0, 50.0, False, "a body rate lies within +-50 rad/s"),
+    "r_rps": (-50.0, 50.0, False, "a body rate lies within +-50 rad/s"),
+    "ax_g": (-100.0, 100.0, False, "a specific force lies within +-100 g"),
+    "ay_g": (-100.0, 100.0, False, "a specific force lies within +-100 g"),
+    "az_g": (-100.0, 100.0, False, "a specific force lies within +-100 g"),
+    "de_rad": (-_PI, _PI, False, "a surface deflection lies within +-pi rad"),
+    "da_rad": (-_PI, _PI, False, "a surface deflection lies within +-pi rad"),
+    "dr_rad": (-_PI, _PI, False, "a surface deflection lies within +-pi rad"),
+    "mach_1": (0.0, 30.0, False, "a Mach number lies in [0, 30]"),
+    "h_ft": (-2.0e4, 2.0e6, False, "a pressure altitude lies within -20,000 and 2,000,000 ft"),
+    "pdot_rps2": (-1.0e4, 1.0e4, False, "an angular acceleration lies within +-10,000 rad/s^2"),
+    "qdot_rps2": (-1.0e4, 1.0e4, False, "an angular acceleration lies within +-10,000 rad/s^2"),
+    "rdot_rps2": (-1.0e4, 1.0e4, False, "an angular acceleration lies within +-10,000 rad/s^2"),
+    "thrust_lbf": (-1.0e7, 1.0e7, False, "a thrust lies within +-10,000,000 lbf"),
+})
+"""Sample limits of the channels (canonical units): a sample outside is refused naming its row."""
 
 
 # --------------------------------------------------------------------------------------
@@ -625,6 +714,7 @@ class Recording:
         t = self._check_time(src)
         self._check_finite(src, t)
         self._check_required(src)
+        self._check_plausible(src, t)
         self._check_format(src)
         self._check_geometry(src)
         self._check_mass(src)
@@ -674,7 +764,7 @@ class Recording:
         bad = np.flatnonzero(~np.isfinite(t))
         if bad.size:
             raise RecordingError(
-                f"non-finite time {float(t[bad[0]])!r} at row {bad[0]}",
+                f"non-finite time {float(t[bad[0]])!r} at {row_label(bad[0])}",
                 source=src, key=_col(time_col), rule="non-finite",
             )
         step = np.diff(t)
@@ -682,8 +772,8 @@ class Recording:
         if bad.size:
             i = int(bad[0])
             raise RecordingError(
-                f"time is not strictly increasing: row {i + 1} has t={float(t[i + 1])!r} after "
-                f"t={float(t[i])!r} at row {i}",
+                f"time is not strictly increasing: {row_label(i + 1)} has t={float(t[i + 1])!r} after "
+                f"t={float(t[i])!r} at row {i + 1}",
                 source=src, key=_col(time_col), rule="time-not-increasing",
             )
         mean_step = (t[-1] - t[0]) / (len(t) - 1)
@@ -691,8 +781,8 @@ class Recording:
         worst = int(np.argmax(dev))
         if dev[worst] > TIME_JITTER_TOL:
             raise RecordingError(
-                f"time step is not uniform: step {float(step[worst])!r} s between rows {worst} and "
-                f"{worst + 1} (t={float(t[worst])!r}) deviates by {dev[worst]:.3g} (relative) from the "
+                f"time step is not uniform: step {float(step[worst])!r} s between rows {worst + 1} and "
+                f"{worst + 2} ({ROW_CONVENTION}; t={float(t[worst])!r}) deviates by {dev[worst]:.3g} (relative) from the "
                 f"mean step {float(mean_step)!r} s; tolerance {TIME_JITTER_TOL:g}",
                 source=src, key=_col(time_col), rule="time-not-uniform",
             )
@@ -705,9 +795,25 @@ class Recording:
             if bad.size:
                 i = int(bad[0])
                 raise RecordingError(
-                    f"non-finite sample {float(values[i])!r} at row {i} (t={float(t[i])!r} s); "
+                    f"non-finite sample {float(values[i])!r} at {row_label(i)}, t={float(t[i])!r} s; "
                     f"{bad.size} bad sample(s) in all",
                     source=src, key=_col(name), rule="non-finite",
+                )
+
+    def _check_plausible(self, src: str, t: np.ndarray) -> None:
+        for name, (low, high, low_open, why) in PHYSICAL_LIMITS.items():
+            if name not in self.data.columns:
+                continue
+            values = self.data[name].to_numpy()
+            below = values <= low if low_open else values < low
+            bad = np.flatnonzero(below | (values > high))
+            if bad.size:
+                i = int(bad[0])
+                bracket = "(" if low_open else "["
+                raise RecordingError(
+                    f"physically impossible sample {float(values[i])!r} at {row_label(i)}, t={float(t[i])!r} s: "
+                    f"{why}, accepted {bracket}{low:g}, {high:g}]; {bad.size} such sample(s) in all",
+                    source=src, key=_col(name), rule="implausible-value",
                 )
 
     def _check_required(self, src: str) -> None:
@@ -749,6 +855,7 @@ class Recording:
                 f"geometry must be an object, got {type(geometry).__name__}",
                 source=src, key=_metakey("geometry"), rule="bad-geometry",
             )
+        _refuse_unknown_keys(geometry, GEOMETRY_KEYS, src, "geometry")
         for key in GEOMETRY_KEYS:
             if key not in geometry:
                 raise RecordingError(
@@ -769,6 +876,7 @@ class Recording:
                 f"mass must be an object, got {type(mass).__name__}",
                 source=src, key=_metakey("mass"), rule="bad-mass",
             )
+        _refuse_unknown_keys(mass, MASS_KEYS, src, "mass")
         for key in MASS_KEYS:
             in_meta = key in mass
             in_data = key in self.data.columns
@@ -796,7 +904,7 @@ class Recording:
                 bad = np.flatnonzero(values <= 0)
                 if bad.size:
                     raise RecordingError(
-                        f"must be positive, got {float(values[bad[0]])!r} at row {bad[0]}",
+                        f"must be positive, got {float(values[bad[0]])!r} at {row_label(bad[0])}",
                         source=src, key=_col(key), rule="bad-mass",
                     )
 
@@ -826,3 +934,9 @@ class Recording:
                 f"must be an object, got {type(self.meta['trim']).__name__}",
                 source=src, key=_metakey("trim"), rule="bad-trim",
             )
+        for key, value in self.meta.get("trim", {}).items():
+            if not _finite_real(value):
+                raise RecordingError(
+                    f"trim values must be finite numbers (not text), got {value!r}",
+                    source=src, key=_metakey("trim", key), rule="bad-trim",
+                )

@@ -201,7 +201,7 @@ def test_to_canonical_refuses_non_numeric() -> None:
     df = pd.DataFrame({"t_s": [0.0, 1.0], "alpha_rad": [0.1, "x"]})
     with pytest.raises(RecordingError, match="non-numeric") as info:
         to_canonical(df, SOURCE)
-    assert "'alpha_rad'" in str(info.value) and "row 1" in str(info.value)
+    assert "'alpha_rad'" in str(info.value) and "row 2" in str(info.value)
 
 
 # ------------------------------------------------------------------ the valid case
@@ -291,7 +291,7 @@ def test_time_not_strictly_increasing() -> None:
         t[40], t[41] = t[41], t[40]
         df["t_s"] = t
 
-    refused(with_data(make_recording(), edit), "'t_s'", "time-not-increasing", "row 41")
+    refused(with_data(make_recording(), edit), "'t_s'", "time-not-increasing", "row 42")
 
 
 def test_time_repeated_sample_is_not_increasing() -> None:
@@ -309,7 +309,7 @@ def test_time_step_not_uniform() -> None:
         t[50] += 0.02 * 1e-5
         df["t_s"] = t
 
-    refused(with_data(make_recording(), edit), "'t_s'", "time-not-uniform", "rows 49 and 50")
+    refused(with_data(make_recording(), edit), "'t_s'", "time-not-uniform", "rows 50 and 51")
 
 
 def test_time_jitter_below_tolerance_is_accepted() -> None:
@@ -329,7 +329,7 @@ def test_non_finite_sample(bad: float) -> None:
         x[30] = bad
         df["q_rps"] = x
 
-    err = refused(with_data(make_recording(), edit), "'q_rps'", "non-finite", "row 17", "t=0.34")
+    err = refused(with_data(make_recording(), edit), "'q_rps'", "non-finite", "row 18", "t=0.34")
     assert "2 bad sample" in str(err)
 
 
@@ -339,7 +339,7 @@ def test_non_finite_time() -> None:
         t[3] = np.nan
         df["t_s"] = t
 
-    refused(with_data(make_recording(), edit), "'t_s'", "non-finite", "row 3")
+    refused(with_data(make_recording(), edit), "'t_s'", "non-finite", "row 4")
 
 
 @pytest.mark.parametrize("quantity", [q for q in REQUIRED_QUANTITIES if q != "t"])
@@ -456,7 +456,7 @@ def test_mass_channel_not_positive() -> None:
         x[7] = -1.0
         df["mass_slug"] = x
 
-    refused(with_data(rec, edit), "'mass_slug'", "bad-mass", "row 7")
+    refused(with_data(rec, edit), "'mass_slug'", "bad-mass", "row 8")
 
 
 def test_bad_sensor_position() -> None:
