@@ -64,6 +64,45 @@ def moment_coefficients(p, q, r, pdot, qdot, rdot, qbar_psf, S_ft2, b_ft, cbar_f
 
 Differentiator = Callable[[np.ndarray, float], np.ndarray]
 
+# Coefficients whose Eqs. 1-5 involve thrust: CX (Eq. 1) and, through it, CL and CD (Eq. 2);
+# Cm through the thrust line's moment T z_T when the offset is not zero.
+THRUST_COEFFICIENTS = ("CX", "CL", "CD")
+
+
+def thrust_source(rec: Recording) -> tuple[np.ndarray | float, str]:
+    """Thrust for Eqs. 1 and 4, and where it came from.
+
+    ``../shared/recording-format.md``: thrust is optional and "assumed constant at trim if
+    absent". So: the ``thrust`` channel when recorded (``'recorded'``); else the constant
+    ``meta['trim']['thrust_lbf']`` (``'trim'``); else 0 (``'unknown'``), the only value
+    left when the trim thrust is not known either. A constant thrust T left out shifts CX by
+    ``-T/(q̄S)`` (and CL, CD by its projections, Cm by ``-T z_T/(q̄Sc̄)``): a bias-term shift,
+    exact when q̄ is constant.
+    """
+    if rec.has("thrust"):
+        return rec.channel("thrust"), "recorded"
+    trim = rec.meta.get("trim", {})
+    if "thrust_lbf" in trim:
+        return float(trim["thrust_lbf"]), "trim"
+    return 0.0, "unknown"
+
+
+def thrust_assumption(rec: Recording, coefficient: str) -> tuple[str, ...]:
+    """What ``coefficient`` computed by Eqs. 1-5 assumes about thrust (empty when nothing)."""
+    offset = float(rec.meta.get("thrust_offset_ft", 0.0))
+    if coefficient not in THRUST_COEFFICIENTS and not (coefficient == "Cm" and offset != 0.0):
+        return ()
+    thrust, source = thrust_source(rec)
+    if source == "recorded":
+        return ()
+    if source == "trim":
+        return (f"thrust not recorded: assumed constant at its trim value, {thrust:.6g} lbf "
+                "(recording format)",)
+    shift = "-T z_T/(q̄S c̄)" if coefficient == "Cm" else "-T/(q̄S)"
+    return (f"thrust neither recorded nor known at trim (meta trim.thrust_lbf): taken as 0 lbf, so "
+            f"{coefficient} lacks the term {shift} of the constant trim thrust T, which the bias "
+            "term absorbs (exactly when q̄ is constant)",)
+
 
 def coefficients_from_recording(rec: Recording, differentiate: Differentiator | None = None) -> pd.DataFrame:
     """CX, CY, CZ, CL, CD, Cl, Cm, Cn from a recording's channels (Eqs. 1-5).
@@ -72,7 +111,8 @@ def coefficients_from_recording(rec: Recording, differentiate: Differentiator | 
     ----------
     rec : Recording
         Canonical recording; thrust is taken as recorded, or as ``meta['trim']['thrust_lbf']``
-        (constant) when the channel is absent, or zero.
+        (constant) when the channel is absent, or zero when neither is known
+        (:func:`thrust_source`; :func:`thrust_assumption` says what that assumes).
     differentiate : callable or None
         ``(x, dt) -> dx/dt`` used for the angular accelerations. ``None`` uses the recorded
         ``pdot``, ``qdot``, ``rdot`` channels (refused, naming them, if absent).
@@ -83,10 +123,7 @@ def coefficients_from_recording(rec: Recording, differentiate: Differentiator | 
     else:
         pdot, qdot, rdot = (differentiate(x, rec.dt) for x in (p, q, r))
     g, m = rec.geometry, rec.mass_at()
-    if rec.has("thrust"):
-        thrust = rec.channel("thrust")
-    else:
-        thrust = float(rec.meta.get("trim", {}).get("thrust_lbf", 0.0))
+    thrust, _ = thrust_source(rec)
     r_acc = rec.meta.get("sensors", {}).get("accelerometer_ft", [0.0, 0.0, 0.0])
     ax, ay, az = accelerometer_at_cg(rec.channel("ax"), rec.channel("ay"), rec.channel("az"),
                                      p, q, r, pdot, qdot, rdot, r_acc)

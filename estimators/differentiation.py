@@ -172,9 +172,9 @@ def local_derivative_noise_shape(
     5-point quadratic, ``c_1 = 1/(10 dt)``, ``c_2 = 2/(10 dt)`` and
     ``|H| = |sin(theta) + 2 sin(2 theta)|/(5 dt)``. White noise of variance ``sigma^2`` on
     ``x`` becomes noise of spectral density ``sigma^2 |H(f)|**2`` on ``d``: a floor that
-    rises as ``(2 pi f)**2`` at low frequency, peaks near ``theta = 1.2`` (f about
-    ``0.19/dt``), vanishes at ``cos(theta) = -1/4`` and falls again towards the Nyquist
-    frequency. The optimal Fourier smoother needs this shape to put the automatic
+    rises as ``(2 pi f)**2`` at low frequency, peaks near ``theta = 0.87`` (where
+    ``cos(theta) + 4 cos(2 theta) = 0``; f about ``0.14/dt``, 6.9 Hz at 50 Hz), vanishes at
+    ``cos(theta) = -1/4`` and falls again towards the Nyquist frequency. The optimal Fourier smoother needs this shape to put the automatic
     cut-off of a differentiated record where its signal meets *that* floor (seed method 3;
     :func:`estimators.smoothing.optimal_fourier_smoother`, ``noise_shape``).
 

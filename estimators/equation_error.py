@@ -7,12 +7,12 @@ the method go to the constructor, so methods are swapped in one line.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from estimators.colored import colored_residual_covariance
-from estimators.fourier import finite_fourier_transform, seed_frequencies
+from estimators.fourier import finite_fourier_transform, seed_frequencies, seed_rule_frequencies
 from estimators.least_squares import least_squares, r_squared
 from estimators.regressors import DataOptions, Equation, RegressionData, regression_data
 from estimators.result import ModelFit, collinearity
@@ -20,6 +20,25 @@ from estimators.smoothing import optimal_fourier_smoother, sine_series_filter
 from maneuvers.recording import Recording
 
 ERRORS = ("conventional", "colored")
+DETRENDS = ("lstsq", "endpoints")
+# Named frequency bands of the frequency-domain method: "auto", the seed's rule (2/T to 1.2 Hz
+# by 0.04 Hz, §II after Eq. 18); "eq18" (alias "sidpac"), Eq. 18's fixed 0.20:0.04:1.20 Hz,
+# SIDPAC's choice and the seed's for its own 10 s examples.
+BANDS = ("auto", "eq18", "sidpac")
+# The SIDPAC convention of the frequency-domain method, by name: Eq. 18's band and the line
+# through the end points. ``make_estimator("ee-freq", **SIDPAC_FREQUENCY_OPTIONS)``.
+SIDPAC_FREQUENCY_OPTIONS = {"frequencies_hz": "sidpac", "detrend": "endpoints"}
+
+# When the colored-residual (Eq. 40) standard error of a parameter exceeds the white-
+# residual (Eq. 15) one by more than this factor, the residuals are called strongly coloured
+# and the fit says so: conventional ±2σ intervals whose σ is 1.5 times too small cover
+# P(|Z| < 2/1.5) = 82 % instead of 95 %. For white residuals the ratio scatters about 1 by
+# roughly 1/sqrt(2m) in standard error, m the number of frequency bins the regressors span
+# (about 0.12 measured for broadband regressors below 1.5 Hz over 40 s: the test's 40 seeds
+# range 0.71-1.23), so 1.5 is about four of those from 1. Below 1 (residual power above the
+# regressors' band) the conventional bounds are conservative; that side is flagged at 1/2.
+COLOURED_SE_RATIO = 1.5
+COLOURED_SE_RATIO_LOW = 0.5
 
 
 def _as_data(source: Recording | RegressionData, equation: Equation | None, options: DataOptions) -> RegressionData:
@@ -39,6 +58,40 @@ def _warnings(names: tuple[str, ...], fit_coll, notes: tuple[str, ...]) -> tuple
     return tuple(w)
 
 
+def colored_to_conventional_se(cov_colored: np.ndarray, cov_conventional: np.ndarray) -> np.ndarray:
+    """Per parameter, the colored-residual standard error (Eq. 40) over the white-residual one
+    (Eq. 15): 1 for white residuals, far from 1 when the residuals are coloured (seed §III.E)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.sqrt(np.diag(cov_colored) / np.diag(cov_conventional))
+
+
+def coloured_residuals_warning(names: tuple[str, ...], ratio: np.ndarray, errors: str,
+                               limit: float = COLOURED_SE_RATIO,
+                               low_limit: float = COLOURED_SE_RATIO_LOW) -> str | None:
+    """A warning when the residuals are strongly coloured (see :data:`COLOURED_SE_RATIO`),
+    whichever bounds were reported; ``None`` otherwise.
+
+    The bias is left out: a constant regressor sees only the residuals' zero frequency, and
+    with all lags Eq. 39 sums to ``sum_k R(k) = (sum v)**2/N``, zero for the residuals of a
+    fit with a bias term, so its Eq. 40 variance says nothing about colour.
+    """
+    keep = np.isfinite(ratio) & np.array([n != "bias" for n in names])
+    if not keep.any():
+        return None
+    safe = np.where(keep, ratio, 1.0)
+    # distance beyond the limit on either side, in log units (<= 0 inside the limits)
+    over = np.where(keep, np.maximum(np.log(safe / limit), np.log(low_limit / safe)), -np.inf)
+    j = int(np.argmax(over))
+    if over[j] <= 0.0:
+        return None
+    what = (f"the colored-residual (Eq. 40) standard error of {names[j]} is {ratio[j]:.2g} times the "
+            f"white-residual (Eq. 15) one")
+    if errors == "colored":
+        return f"residuals are strongly coloured: {what}; the bounds reported are the colored ones (seed §III.E)"
+    return (f"residuals are strongly coloured: {what}, so the conventional bounds reported here are off by "
+            "that factor; use colored errors (Eq. 40, seed §III.E)")
+
+
 @dataclass(frozen=True)
 class EquationErrorTime:
     """Ordinary least squares in the time domain (seed Eqs. 12-17).
@@ -46,7 +99,12 @@ class EquationErrorTime:
     Parameters
     ----------
     errors : ``'conventional'`` (Eq. 15, white residuals) or ``'colored'`` (Eqs. 37-41, the
-        residual autocorrelation up to ``max_lag`` samples; all lags when None).
+        residual autocorrelation up to ``max_lag`` samples; all lags when None). ``None``
+        (default) is the method's own: ``'colored'`` with smoothed regressors (smoothing
+        colours the residuals, and the seed's §III.E finds the colored bounds of smoothed
+        regressors accurate), ``'conventional'`` without. Either way the fit warns when the
+        residuals are strongly coloured (:data:`COLOURED_SE_RATIO`) and reports the ratio of
+        the two standard errors in ``info['colored_to_conventional_se']``.
     smooth_regressors : smooth the regressors with the optimal Fourier smoother first (the
         seed's method 4 of §III.C), which removes most of the regressor-noise bias of Eq. 32.
         One filter serves every column: each regressor's optimal (Wiener) weights are found
@@ -62,12 +120,14 @@ class EquationErrorTime:
     data : how the recording becomes z and X (angular accelerations, perturbations).
     """
 
-    errors: str = "conventional"
+    errors: str | None = None
     max_lag: int | None = None
     smooth_regressors: bool = False
     data: DataOptions = field(default_factory=DataOptions)
 
     def __post_init__(self) -> None:
+        if self.errors is None:
+            object.__setattr__(self, "errors", "colored" if self.smooth_regressors else "conventional")
         if self.errors not in ERRORS:
             raise ValueError(f"errors must be one of {ERRORS}, not {self.errors!r}")
 
@@ -86,23 +146,28 @@ class EquationErrorTime:
             info["smoother_cutoff_hz"] = max(f.cutoff_hz for f in fits)
         A = np.column_stack([X, np.ones(len(z))]) if d.equation.bias else X
         ls = least_squares(A, z, d.names)
-        if self.errors == "colored":
-            cov = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag)
-        else:
-            cov = ls.s2 * ls.xtx_inv
+        cov_colored = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag)
+        cov_conventional = ls.s2 * ls.xtx_inv
+        cov = cov_colored if self.errors == "colored" else cov_conventional
+        ratio = colored_to_conventional_se(cov_colored, cov_conventional)
+        info["colored_to_conventional_se"] = [float(r) for r in ratio]
         coll = collinearity(A, d.names, cov)
+        colour = coloured_residuals_warning(d.names, ratio, self.errors)
         return ModelFit(method=self.method, domain="time", dependent=d.equation.dependent, names=d.names,
                         params=ls.theta, cov=cov, residuals=ls.residuals, fitted=ls.fitted, n=len(d.z),
                         s2=ls.s2, r2=r_squared(z, ls.residuals), errors=self.errors, collinearity=coll,
-                        warnings=_warnings(d.names, coll, d.notes),
+                        warnings=_warnings(d.names, coll, d.notes) + ((colour,) if colour else ()),
+                        assumptions=d.assumptions,
                         info=info | ({"max_lag": self.max_lag if self.max_lag is not None else len(z) - 1}
                                      if self.errors == "colored" else {}))
 
 
-def detrend(x: np.ndarray, how: str = "endpoints") -> np.ndarray:
-    """Remove a straight line from each column: through the first and last samples
-    (``'endpoints'``, so the record starts and ends at zero) or fitted by least squares
-    (``'lstsq'``)."""
+def detrend(x: np.ndarray, how: str = "lstsq") -> np.ndarray:
+    """Remove a straight line from each column: fitted by least squares (``'lstsq'``, the
+    default) or through the first and last samples (``'endpoints'``, so the record starts and
+    ends at zero: SIDPAC's choice). With noisy data the end-point line carries the noise of
+    two samples and adds a random ramp, in band, to every series; the least-squares line
+    averages all of them. Both are linear, so ``z = X theta`` survives either exactly."""
     x = np.asarray(x, dtype=float)
     n = x.shape[0]
     s = np.linspace(0.0, 1.0, n).reshape(-1, *([1] * (x.ndim - 1)))
@@ -115,24 +180,52 @@ def detrend(x: np.ndarray, how: str = "endpoints") -> np.ndarray:
     raise ValueError(f"detrend must be 'endpoints' or 'lstsq', not {how!r}")
 
 
+def frequency_band(frequencies_hz, duration_s: float) -> np.ndarray:
+    """The frequencies (Hz) of a band specification for a record of ``duration_s`` seconds.
+
+    ``None`` or ``'auto'``: the seed's rule, 2/T to 1.2 Hz by 0.04 Hz
+    (:func:`estimators.fourier.seed_rule_frequencies`); ``'eq18'`` or ``'sidpac'``: Eq. 18,
+    0.20:0.04:1.20 Hz; otherwise the frequencies given.
+    """
+    if frequencies_hz is None or (isinstance(frequencies_hz, str) and frequencies_hz == "auto"):
+        return seed_rule_frequencies(duration_s)
+    if isinstance(frequencies_hz, str):
+        if frequencies_hz in ("eq18", "sidpac"):
+            return seed_frequencies()
+        raise ValueError(f"frequency band {frequencies_hz!r}: use one of {BANDS} or give frequencies")
+    return np.asarray(frequencies_hz, dtype=float)
+
+
 @dataclass(frozen=True)
 class EquationErrorFrequency:
     """Equation error in the frequency domain (seed Eqs. 19-23), no bias term.
 
-    Each time series is detrended (``'endpoints'`` by default) and transformed with the
-    high-accuracy finite Fourier transform at ``frequencies_hz`` (default the seed's Eq. 18,
-    0.20 to 1.20 Hz in 0.04 Hz steps). The complex least-squares problem is solved through
-    Eq. 23's real stacking; σ̂² divides by m − n_p with m the number of frequencies (Eq. 21).
+    Each time series is detrended (``detrend``: ``'lstsq'``, a least-squares line, by
+    default; ``'endpoints'``, the line through the end points, SIDPAC's) and transformed with
+    the high-accuracy finite Fourier transform at ``frequencies_hz``: by default (``None`` or
+    ``'auto'``) the seed's rule, 2/T to 1.2 Hz in 0.04 Hz steps with T the record length;
+    ``'eq18'``/``'sidpac'`` for Eq. 18's fixed 0.20-1.20 Hz; or the frequencies given.
+    :data:`SIDPAC_FREQUENCY_OPTIONS` names SIDPAC's convention (Eq. 18 and end points). On a
+    20 s 2-1-1-2 the old defaults, Eq. 18 and the end-point line, left 2.5 and 3 Monte Carlo
+    standard errors of bias in the seed's regressor-noise study. The complex least-squares
+    problem is solved through Eq. 23's real stacking; σ̂² divides by m − n_p with m the number
+    of frequencies (Eq. 21).
     """
 
-    frequencies_hz: tuple[float, ...] | None = None
-    detrend: str = "endpoints"
+    frequencies_hz: tuple[float, ...] | str | None = None
+    detrend: str = "lstsq"
     data: DataOptions = field(default_factory=DataOptions)
     method: str = "ee-freq"
 
+    def __post_init__(self) -> None:
+        if self.detrend not in DETRENDS:
+            raise ValueError(f"detrend must be one of {DETRENDS}, not {self.detrend!r}")
+        if isinstance(self.frequencies_hz, str) and self.frequencies_hz not in BANDS:
+            raise ValueError(f"frequency band {self.frequencies_hz!r}: use one of {BANDS} or give frequencies")
+
     def transform(self, d: RegressionData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Frequencies (Hz) and the transforms of z and X."""
-        f = np.asarray(self.frequencies_hz if self.frequencies_hz is not None else seed_frequencies(), dtype=float)
+        f = frequency_band(self.frequencies_hz, (len(d.z) - 1) * d.dt)
         series = np.column_stack([d.z, d.X])
         Z = finite_fourier_transform(detrend(series, self.detrend), d.dt, f)
         return f, Z[:, 0], Z[:, 1:]
@@ -142,9 +235,13 @@ class EquationErrorFrequency:
         if d.equation.bias:
             d = RegressionData(Equation(d.equation.dependent, d.equation.regressors, bias=False),
                                d.z, d.X, d.t, d.dt, d.notes + ("the frequency-domain method estimates no bias "
-                                                                "term (the data are detrended first)",))
+                                                                "term (the data are detrended first)",),
+                               d.assumptions)
         f, z, X = self.transform(d)
-        return fit_frequency_domain(z, X, d.names, d.equation.dependent, f, self.method, d.notes)
+        fit = fit_frequency_domain(z, X, d.names, d.equation.dependent, f, self.method, d.notes)
+        band = self.frequencies_hz if isinstance(self.frequencies_hz, str) else (
+            "auto" if self.frequencies_hz is None else "given")
+        return replace(fit, assumptions=d.assumptions, info={**fit.info, "band": band, "detrend": self.detrend})
 
 
 def fit_frequency_domain(z: np.ndarray, X: np.ndarray, names: tuple[str, ...], dependent: str,

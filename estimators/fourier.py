@@ -21,6 +21,7 @@ Public API
 finite_fourier_transform(x, dt, frequencies_hz, *, t0=0.0)
 plain_dft(x, dt, frequencies_hz, *, t0=0.0)
 seed_frequencies()
+seed_rule_frequencies(duration_s, *, upper_hz=1.2, step_hz=0.04)
 interpolation_weights(theta)
 """
 
@@ -34,8 +35,15 @@ __all__ = [
     "finite_fourier_transform",
     "plain_dft",
     "seed_frequencies",
+    "seed_rule_frequencies",
     "interpolation_weights",
 ]
+
+# The seed's rule for a frequency-domain band (§II, after Eq. 18): "frequency resolution of
+# 0.04 Hz works well", the upper bound "typically around 1.2 Hz for rigid-body modes of
+# full-scale aircraft".
+SEED_STEP_HZ = 0.04
+RIGID_BODY_UPPER_HZ = 1.2
 
 # Monomial coefficients (ascending powers of s) of the cubic Lagrange basis
 # polynomials used on one sampling interval, s = (t - t_m)/dt in [0, 1].
@@ -72,6 +80,46 @@ def seed_frequencies() -> np.ndarray:
         accumulation in ``arange`` can drop or add the last point.
     """
     return np.linspace(0.20, 1.20, 26)
+
+
+def seed_rule_frequencies(duration_s: float, *, upper_hz: float = RIGID_BODY_UPPER_HZ,
+                          step_hz: float = SEED_STEP_HZ) -> np.ndarray:
+    """The band the seed's rule gives a maneuver of length ``T`` (§II, after Eq. 18).
+
+    "The lower bound should be chosen as 2/T, where T is the time length of the maneuver, and
+    the upper bound should be chosen to include the dynamics of interest, typically around
+    1.2 Hz for rigid-body modes of full-scale aircraft", with "frequency resolution of 0.04 Hz".
+    Eq. 18's own 0.20 Hz is this rule for T = 10 s; a 20 s maneuver starts at 0.10 Hz, below
+    which a 20 s record holds less than two cycles.
+
+    Parameters
+    ----------
+    duration_s : float
+        ``T``, the record length ``(N - 1) dt``, s.
+    upper_hz, step_hz : float, optional
+        Upper bound (default 1.2 Hz) and resolution (default 0.04 Hz).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``2/T, 2/T + step, ...`` up to ``upper_hz`` (included when it falls on the grid,
+        within 1e-9 of a step).
+
+    Raises
+    ------
+    ValueError
+        When ``2/T`` exceeds ``upper_hz`` (a record shorter than ``2/upper_hz`` s), or on
+        non-positive arguments.
+    """
+    T, upper, step = float(duration_s), float(upper_hz), float(step_hz)
+    if not (np.isfinite(T) and T > 0 and upper > 0 and step > 0):
+        raise ValueError("duration, upper bound and step must be positive")
+    f0 = 2.0 / T
+    if f0 > upper * (1 + 1e-12):
+        raise ValueError(f"a {T:.3g} s record is too short for the seed's band: its lower bound 2/T = "
+                         f"{f0:.3g} Hz is above the upper bound {upper:.3g} Hz")
+    n = int(np.floor((upper - f0) / step + 1e-9)) + 1
+    return f0 + step * np.arange(n)
 
 
 def _as_frequencies(frequencies_hz: npt.ArrayLike) -> np.ndarray:

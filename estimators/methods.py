@@ -3,11 +3,12 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from estimators.equation_error import EquationErrorFrequency, EquationErrorTime
+from estimators.equation_error import SIDPAC_FREQUENCY_OPTIONS, EquationErrorFrequency, EquationErrorTime
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit
 
 METHODS = ("ee-time", "ee-smooth", "ee-freq", "oe")
+__all__ = ["METHODS", "SIDPAC_FREQUENCY_OPTIONS", "Estimator", "make_estimator", "parse_frequencies"]
 
 
 class Estimator(Protocol):
@@ -19,14 +20,19 @@ class Estimator(Protocol):
     def fit(self, source, equation: Equation | None = None) -> ModelFit: ...
 
 
-def make_estimator(name: str, *, errors: str = "conventional", max_lag: int | None = None,
-                   frequencies_hz: tuple[float, ...] | None = None, detrend: str = "endpoints",
+def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None = None,
+                   frequencies_hz: tuple[float, ...] | str | None = None, detrend: str = "lstsq",
                    data: DataOptions = DataOptions()) -> Estimator:
     """The estimator called ``name`` (one of :data:`METHODS`).
 
-    ``errors`` applies to the time-domain equation-error methods; the frequency-domain method's
-    bounds are conventional (Eqs. 20-22, accurate when the band holds the rigid-body
-    dynamics, seed §III.E), and output error reports the Cramér-Rao bound.
+    ``errors`` applies to the time-domain equation-error methods; ``None`` is the method's
+    default: colored residuals (Eq. 40) for ``ee-smooth``, conventional (Eq. 15) for
+    ``ee-time``. The frequency-domain method's bounds are conventional (Eqs. 20-22, accurate
+    when the band holds the rigid-body dynamics, seed §III.E), and output error reports the
+    Cramér-Rao bound. ``frequencies_hz`` and ``detrend`` shape ``ee-freq``: by default the
+    seed's rule (2/T to 1.2 Hz by 0.04 Hz) and a least-squares line;
+    ``**SIDPAC_FREQUENCY_OPTIONS`` (``frequencies_hz='sidpac'``, ``detrend='endpoints'``)
+    gives SIDPAC's Eq. 18 band and end-point line.
     """
     if name == "ee-time":
         return EquationErrorTime(errors=errors, max_lag=max_lag, data=data)
@@ -44,14 +50,18 @@ def make_estimator(name: str, *, errors: str = "conventional", max_lag: int | No
     raise ValueError(f"unknown method {name!r}; choose one of {METHODS}")
 
 
-def parse_frequencies(text: str) -> tuple[float, ...]:
-    """``'F0:DF:F1'`` (inclusive of F1) or a comma list, in Hz."""
+def parse_frequencies(text: str) -> tuple[float, ...] | str:
+    """``'F0:DF:F1'`` (inclusive of F1) or a comma list, in Hz; or a band by name: ``'auto'``
+    (the seed's rule, 2/T to 1.2 Hz), ``'eq18'`` or ``'sidpac'`` (Eq. 18, 0.20:0.04:1.20)."""
     import numpy as np
+    if text.strip() in ("auto", "eq18", "sidpac"):
+        return text.strip()
     if ":" in text:
         try:
             f0, df, f1 = (float(x) for x in text.split(":"))
         except ValueError:
-            raise ValueError(f"--frequencies must be F0:DF:F1 or a comma list, not {text!r}") from None
+            raise ValueError(f"--frequencies must be auto, eq18, sidpac, F0:DF:F1 or a comma list, "
+                             f"not {text!r}") from None
         if not (0 < f0 < f1 and df > 0):
             raise ValueError(f"--frequencies {text!r}: need 0 < F0 < F1 and DF > 0")
         n = int(round((f1 - f0) / df)) + 1

@@ -27,7 +27,7 @@ import scipy.linalg
 from scipy import signal
 
 from estimators.colored import residual_autocorrelation
-from estimators.equation_error import ERRORS, EquationErrorFrequency, fit_frequency_domain
+from estimators.equation_error import ERRORS, EquationErrorFrequency, fit_frequency_domain, frequency_band
 from estimators.least_squares import SingularRegressorsError, check_rank, least_squares, r_squared
 from estimators.regressors import Equation, RegressionData
 from estimators.result import ModelFit, collinearity
@@ -390,10 +390,11 @@ def fit_sequential(datasets: Sequence[RegressionData], *, equal_variances: bool 
 
 # -- frequency domain --------------------------------------------------------------------------
 def fit_frequency_combined(datasets: Sequence[RegressionData], frequencies_hz: npt.ArrayLike | None = None,
-                           detrend: str = "endpoints") -> ModelFit:
+                           detrend: str = "lstsq") -> ModelFit:
     """Frequency-domain equation error on several maneuvers at common frequencies (seed §III.F).
 
-    Every maneuver is detrended and transformed at the same frequencies (default Eq. 18) by
+    Every maneuver is detrended and transformed at the same frequencies (default the seed's
+    rule for the shortest maneuver: 2/T to 1.2 Hz by 0.04 Hz) by
     :meth:`EquationErrorFrequency.transform`, which handles maneuvers of different lengths.
 
     Interpretation of "the data for the combination of multiple maneuvers is simply the
@@ -414,10 +415,12 @@ def fit_frequency_combined(datasets: Sequence[RegressionData], frequencies_hz: n
     ----------
     datasets : sequence of RegressionData
         Maneuvers of one model equation; any bias term is dropped (the data are detrended).
-    frequencies_hz : array_like, optional
-        The common frequencies (default: seed Eq. 18, 0.20-1.20 Hz by 0.04 Hz).
-    detrend : {'endpoints', 'lstsq'}
-        How each time series is detrended before the transform.
+    frequencies_hz : array_like or str, optional
+        The common frequencies; ``None``/``'auto'`` (default): the seed's rule with T the
+        shortest maneuver's length; ``'eq18'``/``'sidpac'``: Eq. 18, 0.20-1.20 Hz by 0.04 Hz.
+    detrend : {'lstsq', 'endpoints'}
+        How each time series is detrended before the transform (default a least-squares
+        line; ``'endpoints'`` is SIDPAC's line through the end points).
 
     Returns
     -------
@@ -436,8 +439,9 @@ def fit_frequency_combined(datasets: Sequence[RegressionData], frequencies_hz: n
     ds = _common(datasets)
     eq = ds[0].equation
     no_bias = Equation(eq.dependent, eq.regressors, bias=False)
-    est = EquationErrorFrequency(frequencies_hz=None if frequencies_hz is None
-                                 else tuple(float(x) for x in np.atleast_1d(frequencies_hz)),
+    shortest = min((len(d.z) - 1) * d.dt for d in ds)
+    spec = frequencies_hz if frequencies_hz is None or isinstance(frequencies_hz, str) else np.atleast_1d(frequencies_hz)
+    est = EquationErrorFrequency(frequencies_hz=tuple(float(x) for x in frequency_band(spec, shortest)),
                                  detrend=detrend)
     parts = [est.transform(d) for d in ds]
     f = parts[0][0]

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from estimators.coefficients import coefficients_from_recording
+from estimators.coefficients import coefficients_from_recording, thrust_assumption, thrust_source
 from estimators.differentiation import smooth_derivative
 from maneuvers.recording import Recording, RecordingError
 
@@ -101,7 +101,8 @@ class RegressionData:
     """z and X of one equation, sampled uniformly in time.
 
     ``X`` holds the regressors only (N × p); the bias column is added by the estimators that
-    use one. ``t`` is the sample time, ``dt`` its step.
+    use one. ``t`` is the sample time, ``dt`` its step. ``notes`` become the fit's warnings;
+    ``assumptions`` say what building z assumed where the recording was silent (thrust).
     """
 
     equation: Equation
@@ -110,6 +111,7 @@ class RegressionData:
     t: np.ndarray
     dt: float
     notes: tuple[str, ...] = ()
+    assumptions: tuple[str, ...] = ()
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -140,6 +142,7 @@ class _Builder:
     def __init__(self, rec: Recording, options: DataOptions) -> None:
         self.rec, self.opt = rec, options
         self.notes: list[str] = []
+        self.assumptions: list[str] = []
         self.untrimmed: list[str] = []
         self.cache: dict[str, np.ndarray] = {}
         trim = rec.meta.get("trim", {}) if options.reference == "trim" else {}
@@ -220,6 +223,11 @@ class _Builder:
             diff = None
         else:
             diff = lambda x, dt: _differentiate(x, dt, method)  # noqa: E731
+        assumed = thrust_assumption(rec, name)
+        self.assumptions += assumed
+        if assumed and thrust_source(rec)[1] == "unknown":
+            self.notes.append(f"{name} computed with zero thrust: the recording has neither a thrust channel "
+                              "nor a trim thrust (see assumptions)")
         return coefficients_from_recording(rec, diff)[name].to_numpy()
 
 
@@ -244,4 +252,5 @@ def regression_data(rec: Recording, equation: Equation, options: DataOptions = D
     if b.untrimmed:
         notes.append(f"no trim values for {', '.join(b.untrimmed)}: used as measured, so the bias "
                      "includes their steady parts (Eq. 36)")
-    return RegressionData(equation, np.asarray(z, dtype=float), X, rec.t, rec.dt, tuple(notes))
+    return RegressionData(equation, np.asarray(z, dtype=float), X, rec.t, rec.dt, tuple(notes),
+                          tuple(b.assumptions))

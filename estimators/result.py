@@ -105,6 +105,11 @@ class ModelFit:
         Coefficient of determination, 1 − Σ|z − ŷ|²/Σ|z − z̄|².
     errors : str
         How ``cov`` was computed.
+    warnings : tuple of str
+        What the user should know about this result (collinearity, strongly coloured
+        residuals, missing trim values ...).
+    assumptions : tuple of str
+        What was assumed where the recording was silent (e.g. thrust constant at trim).
     """
 
     method: str
@@ -122,6 +127,7 @@ class ModelFit:
     collinearity: Collinearity | None = None
     warnings: tuple[str, ...] = ()
     info: Mapping = field(default_factory=dict)
+    assumptions: tuple[str, ...] = ()
 
     # -- statsmodels-style accessors -------------------------------------------------
     @property
@@ -181,6 +187,7 @@ class ModelFit:
         if self.collinearity is not None:
             lines.append(f"condition number = {self.collinearity.condition_number:.3g}")
         lines += [f"warning: {w}" for w in self.warnings]
+        lines += [f"assumption: {a}" for a in self.assumptions]
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -197,5 +204,6 @@ class ModelFit:
                 "condition_number": self.collinearity.condition_number,
                 "vif": [None if np.isnan(v) else float(v) for v in self.collinearity.vif]},
             "warnings": list(self.warnings),
+            "assumptions": list(self.assumptions),
             "info": {k: v for k, v in self.info.items() if isinstance(v, (int, float, str, list, dict, bool))},
         }

@@ -104,7 +104,7 @@ def regression_with_noise(clean: Recording, noisy: Recording, eq: Equation, appl
     dx = regression_data(x_src, eq, opts)
     z = dx.z if z_src is x_src else regression_data(z_src, eq, opts).z
     z = output_noise(z, dx.t, eq.dependent, noise_model, task.seed)
-    return RegressionData(eq, z, dx.X, dx.t, dx.dt, dx.notes)
+    return RegressionData(eq, z, dx.X, dx.t, dx.dt, dx.notes, dx.assumptions)
 
 
 NAN = float("nan")

@@ -9,7 +9,8 @@ import pytest
 from estimators.equation_error import EquationErrorFrequency, EquationErrorTime, detrend
 from estimators.least_squares import SingularRegressorsError, least_squares
 from estimators.methods import make_estimator, parse_frequencies
-from estimators.regressors import RegressionData
+from estimators.regressors import Equation, RegressionData
+from maneuvers.recording import Recording
 from harness.cli import main
 
 
@@ -71,10 +72,13 @@ def test_frequency_domain_recovers_exact_system_without_bias():
 
 def test_detrend_end_points_and_least_squares():
     x = np.linspace(0, 1, 11) * 3 + 2 + np.sin(np.linspace(0, np.pi, 11))
-    e = detrend(x)
+    e = detrend(x, "endpoints")
     assert e[0] == pytest.approx(0) and e[-1] == pytest.approx(0, abs=1e-12)
     line = 5 * np.linspace(0, 1, 11) - 1
     assert np.allclose(detrend(line, "lstsq"), 0, atol=1e-12)
+    # the default is the least-squares line: its residual is orthogonal to 1 and t
+    r = detrend(x)
+    np.testing.assert_allclose([r.sum(), r @ np.arange(11)], 0.0, atol=1e-12)
 
 
 def test_singular_regressors_are_named():
@@ -140,3 +144,119 @@ def test_estimate_errors_are_clear(tmp_path, shared_dir, capsys):
     src = shared_dir / "data" / "sidpac" / "totter_f1_017_data.mat"
     assert main(["estimate", "--recording", str(src), "--dependent", "Cn", "--regressors", "beta,warp"]) == 2
     assert "unknown regressor term 'warp'" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- defaults that follow the findings
+
+
+def _coloured_problem(phi: float, seed: int = 3, n: int = 2001):
+    """Broadband smooth regressors (20 random sines each, 0.1-1.5 Hz, as a maneuver's
+    response) and AR(1) equation error with coefficient ``phi`` (white for phi = 0),
+    innovations of standard deviation 0.01."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 0.02
+    X = np.column_stack([np.sin(2 * np.pi * np.multiply.outer(t, rng.uniform(0.1, 1.5, 20))
+                                + rng.uniform(0, 2 * np.pi, 20)).sum(axis=1) for _ in range(2)])
+    e = np.zeros(n)
+    w = 0.01 * rng.normal(size=n)
+    for i in range(1, n):
+        e[i] = phi * e[i - 1] + w[i]
+    return RegressionData.from_arrays(X @ [1.0, -0.5] + 0.2 + e, X, ("a", "b"), 0.02)
+
+
+def test_ee_smooth_defaults_to_colored_bounds_ee_time_to_conventional():
+    assert make_estimator("ee-smooth").errors == "colored"
+    assert EquationErrorTime(smooth_regressors=True).errors == "colored"
+    assert make_estimator("ee-time").errors == "conventional"
+    assert make_estimator("ee-smooth", errors="conventional").errors == "conventional"
+    d = _coloured_problem(0.0)
+    fit = make_estimator("ee-smooth").fit(d)
+    assert fit.errors == "colored" and "max_lag" in fit.info
+
+
+def test_strongly_coloured_residuals_are_flagged_whichever_bounds():
+    """AR(1) residuals with phi = 0.95 have, below 1.5 Hz, a spectral density about
+    (1 - phi)^-2 / ((1 - phi^2)^-1) = (1 + phi)/(1 - phi) = 39 times their white equivalent,
+    a standard-error ratio near 6 at the flat part of the spectrum (3-4 here): flagged with
+    either bounds. White residuals give ratios of 1 within their sampling scatter (measured
+    about 0.12 in standard error for these regressors), far inside [1/2, 1.5]: not flagged."""
+    red = _coloured_problem(0.95)
+    for errors in ("conventional", "colored"):
+        fit = EquationErrorTime(errors=errors).fit(red)
+        ratio = np.asarray(fit.info["colored_to_conventional_se"])
+        assert ratio[:2].max() > 2.5
+        msg = [w for w in fit.warnings if "strongly coloured" in w]
+        assert len(msg) == 1 and ("colored errors" in msg[0]) == (errors == "conventional")
+    for seed in range(20):
+        white = EquationErrorTime().fit(_coloured_problem(0.0, seed))
+        assert not any("coloured" in w for w in white.warnings)
+        assert np.all(np.abs(np.asarray(white.info["colored_to_conventional_se"][:2]) - 1) < 0.4)
+
+
+def test_frequency_band_names_and_the_seed_rule():
+    from estimators.equation_error import frequency_band
+    from estimators.fourier import seed_frequencies, seed_rule_frequencies
+    f = seed_rule_frequencies(20.0)
+    assert f[0] == pytest.approx(0.1) and f[-1] == pytest.approx(1.18) and len(f) == 28
+    np.testing.assert_allclose(seed_rule_frequencies(10.0), seed_frequencies(), atol=1e-12)  # Eq. 18 is T = 10 s
+    with pytest.raises(ValueError, match="too short"):
+        seed_rule_frequencies(1.0)
+    for name in ("eq18", "sidpac"):
+        assert parse_frequencies(name) == name
+        np.testing.assert_array_equal(frequency_band(name, 20.0), seed_frequencies())
+    assert parse_frequencies("auto") == "auto"
+    with pytest.raises(ValueError, match="frequency band"):
+        EquationErrorFrequency(frequencies_hz="weekly")
+    with pytest.raises(ValueError, match="detrend"):
+        EquationErrorFrequency(detrend="quadratic")
+
+
+def test_sidpac_convention_by_name_on_the_twin_otter(shared_dir):
+    """SIDPAC parity needs Eq. 18's band and the end-point line, named explicitly: they give
+    the same numbers as before the defaults changed (the README's Twin Otter table, 5 figures)
+    and, to 1e-12, the same as spelling the options out."""
+    from estimators.fourier import seed_frequencies
+    from estimators.methods import SIDPAC_FREQUENCY_OPTIONS
+    from harness.recording_io import read_recording
+    rec = read_recording(shared_dir / "data" / "sidpac" / "totter_f1_017_data.mat")
+    eq = Equation("Cn", ("beta", "phat", "rhat", "da", "dr"), bias=False)
+    named = make_estimator("ee-freq", **SIDPAC_FREQUENCY_OPTIONS).fit(rec, eq)
+    spelled = EquationErrorFrequency(frequencies_hz=tuple(seed_frequencies()), detrend="endpoints").fit(rec, eq)
+    np.testing.assert_allclose(named.params, spelled.params, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(named.bse, spelled.bse, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(named.params, [0.083647, -0.061, -0.20348, 0.0011649, -0.1332], rtol=5e-5)
+    np.testing.assert_allclose(named.bse, [0.00117, 0.00499, 0.00411, 0.00178, 0.00192], rtol=5e-3)
+    default = make_estimator("ee-freq").fit(rec, eq)
+    T = (rec.n - 1) * rec.dt
+    assert default.info["frequencies_hz"][0] == pytest.approx(2 / T) and default.info["detrend"] == "lstsq"
+
+
+def test_thrust_follows_the_format_and_says_what_it_assumed(three_axis_exact):
+    """No thrust channel: thrust is constant at trim (recording-format.md), said in the
+    assumptions. No trim thrust either: 0, said in the assumptions and the warnings, and CX's
+    bias moves by T/(q̄S)."""
+    from estimators.regressors import regression_data
+    rec = three_axis_exact
+    no_channel = Recording(rec.data.drop(columns=[rec.column("thrust")]), rec.meta, "no-thrust")
+    meta = {**rec.meta, "trim": {k: v for k, v in rec.meta["trim"].items() if k != "thrust_lbf"}}
+    nothing = Recording(no_channel.data, meta, "no-trim-thrust")
+    eq = Equation("CX", ("alpha", "qhat", "de"))
+    recorded = EquationErrorTime().fit(rec, eq)
+    at_trim = EquationErrorTime().fit(no_channel, eq)
+    unknown = EquationErrorTime().fit(nothing, eq)
+    assert recorded.assumptions == ()
+    assert len(at_trim.assumptions) == 1 and "constant at its trim value" in at_trim.assumptions[0]
+    assert not any("thrust" in w for w in at_trim.warnings)
+    assert len(unknown.assumptions) == 1 and "taken as 0" in unknown.assumptions[0]
+    assert any("zero thrust" in w for w in unknown.warnings)
+    T, qS = rec.meta["trim"]["thrust_lbf"], rec.meta["trim"]["qbar_psf"] * rec.geometry["S_ft2"]
+    shift = unknown.param("bias") - at_trim.param("bias")
+    assert shift == pytest.approx(T / qS, rel=0.05)
+    js = unknown.to_dict()
+    assert js["assumptions"] == list(unknown.assumptions)
+    assert "assumption: thrust" in unknown.summary()
+    # Cm carries the thrust line's moment (offset -0.3 ft); CZ does not involve thrust
+    assert regression_data(nothing, Equation("Cm", ("alpha",))).assumptions
+    assert not regression_data(nothing, Equation("CZ", ("alpha",))).assumptions
+    freq = make_estimator("ee-freq").fit(nothing, Equation("CX", ("alpha", "qhat", "de"), bias=False))
+    assert freq.assumptions == unknown.assumptions

@@ -224,7 +224,10 @@ def test_frequency_combination_sums_normal_equations_and_equals_stacking() -> No
     rng = np.random.default_rng(31)
     ds = [smooth_maneuver(rng, 20.0, 0.05), smooth_maneuver(rng, 13.3, 0.05), smooth_maneuver(rng, 31.1, 0.05)]
     fit = fit_frequency_combined(ds)
-    est = EquationErrorFrequency()
+    f = np.asarray(fit.info["frequencies_hz"])
+    # default band: the seed's rule for the shortest maneuver, 2/T to 1.2 Hz by 0.04 Hz
+    assert f[0] == pytest.approx(2 / (round(13.3 / DT) * DT)) and f[-1] <= 1.2 and len(f) == 27
+    est = EquationErrorFrequency(frequencies_hz=tuple(f))
     parts = [est.transform(d) for d in ds]
     m = sum(len(p[0]) for p in parts)
     XtX = sum(np.real(p[2].conj().T @ p[2]) for p in parts)  # Σ Re(X̃ᵢ†X̃ᵢ)
@@ -234,7 +237,7 @@ def test_frequency_combination_sums_normal_equations_and_equals_stacking() -> No
     X = np.vstack([p[2] for p in parts])
     v = z - X @ theta
     s2 = float(np.real(np.vdot(v, v))) / (m - 3)  # Eq. 21 with m = all frequency points
-    assert fit.n == m == 3 * 26
+    assert fit.n == m == 3 * len(f)
     assert rel_err(fit.params, theta) < 1e-10
     assert abs(fit.s2 - s2) < 1e-9 * s2
     assert rel_err(fit.cov, s2 * np.linalg.inv(XtX)) < 1e-9  # Eq. 20
@@ -254,9 +257,14 @@ def test_frequency_combination_of_one_maneuver_is_the_single_fit() -> None:
 
 def test_frequency_combination_warns_about_short_maneuvers() -> None:
     rng = np.random.default_rng(33)
-    fit = fit_frequency_combined([smooth_maneuver(rng, 20.0, 0.05), smooth_maneuver(rng, 6.0, 0.05)])
+    ds = [smooth_maneuver(rng, 20.0, 0.05), smooth_maneuver(rng, 6.0, 0.05)]
+    fit = fit_frequency_combined(ds, frequencies_hz="eq18")  # Eq. 18's 0.2 Hz < 2/6 s
     assert any("maneuver 1 lasts 6 s" in w and "2/T" in w for w in fit.warnings)
     assert not any("maneuver 0 lasts" in w for w in fit.warnings)
+    # the default band follows the seed's rule for the shortest maneuver: no warning
+    auto = fit_frequency_combined(ds)
+    assert auto.info["frequencies_hz"][0] == pytest.approx(2 / 6.0)
+    assert not any("lasts" in w for w in auto.warnings)
 
 
 # ---------------------------------------------------------------- colored residuals across joins
