@@ -8,14 +8,16 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
+from harness.errors import OutputPathError
+
 
 def write_atomic(path: str | Path, writer: Callable[[IO[bytes]], Any]) -> Path:
     """Call ``writer(fh)`` on a temporary file beside ``path`` and rename it into place.
 
     A crash or kill leaves either the old file or the new one, never half of one.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path = check_output_file(path)
+    ensure_folder(path.parent)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -30,6 +32,38 @@ def write_atomic(path: str | Path, writer: Callable[[IO[bytes]], Any]) -> Path:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    return path
+
+
+def _first_file_on_the_way(folder: Path) -> Path | None:
+    """The first existing non-folder among ``folder`` and its parents, if any."""
+    for p in (folder, *folder.parents):
+        if p.exists():
+            return None if p.is_dir() else p
+    return None
+
+
+def ensure_folder(folder: str | Path, what: str = "folder") -> Path:
+    """Create ``folder`` (and its parents), or refuse naming the file that is in the way."""
+    folder = Path(folder)
+    blocker = _first_file_on_the_way(folder)
+    if blocker is not None:
+        raise OutputPathError(f"{folder}: cannot create this {what}: {blocker} is a file, not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputPathError(f"{folder}: cannot create this {what}: {exc.strerror or exc}") from None
+    return folder
+
+
+def check_output_file(path: str | Path, what: str = "output file") -> Path:
+    """Refuse, before any work, an output file that is a folder or whose folder is a file."""
+    path = Path(path)
+    if path.is_dir():
+        raise OutputPathError(f"{path}: cannot write this {what}: it is a folder")
+    blocker = _first_file_on_the_way(path.parent)
+    if blocker is not None:
+        raise OutputPathError(f"{path}: cannot write this {what}: {blocker} is a file, not a folder")
     return path
 
 

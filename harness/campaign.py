@@ -8,14 +8,17 @@ Seeds derive from the master seed and the identity of the flight, noise and real
 """
 from __future__ import annotations
 
+import difflib
 import hashlib
 import itertools
 import json
+import os
 import tomllib
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from estimators.regressors import Equation
+from harness.errors import UserError
 from harness.noise import ChannelNoise, NoiseModel
 from harness.noise_presets import PRESETS, preset
 from models.atmosphere import Turbulence
@@ -26,8 +29,116 @@ APPLY_TO = ("both", "regressors", "outputs")
 COMBINED_METHODS = ("ee-concat", "ee-sequential", "ee-sequential-unequal", "ee-freq-combined")
 
 
-class CampaignError(ValueError):
+class CampaignError(UserError):
     """A campaign file that cannot be run; the message names the file and the key."""
+
+
+# Every key a campaign file may use, per table; anything else is refused (a typo would
+# otherwise silently run something else than what was asked for).
+TOP_KEYS = ("name", "description", "seed", "realizations", "truth", "combine", "grid", "flight", "flights",
+            "maneuvers", "noise", "method_options", "method_factories", "plugins", "report")
+GRID_KEYS = ("aircraft", "variant", "condition", "maneuver", "loop", "noise", "method", "errors", "equations")
+FLIGHT_DEFAULT_KEYS = ("duration_s", "sample_rate_hz")
+FLIGHT_KEYS = ("aircraft", "variant", "condition", "maneuver", "loop", "duration_s")
+NOISE_KEYS = ("preset", "scale", "apply_to", "output", "flight_scales")
+PLUGIN_KEYS = ("allow",)
+CAMPAIGN_VARIANTS = ("nominal", "exact-truth", "unstable", "linear")
+PLUGINS_ENV = "SIDBENCH_PLUGINS"
+"""Environment variable: a comma list of ``module:callable`` plug-ins allowed in ``[method_factories]``
+(besides a campaign's own ``[plugins] allow = [...]``)."""
+
+
+def _did_you_mean(word: str, known: tuple[str, ...]) -> str:
+    close = difflib.get_close_matches(word, list(known), n=1)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def _known_keys(table: object, known: tuple[str, ...], where: str, file: str) -> dict:
+    """``table`` as a dict whose keys are all in ``known``; otherwise an error listing them."""
+    if not isinstance(table, dict):
+        raise CampaignError(f"{file}: {where} must be a table, not {_kind(table)}")
+    for key in table:
+        if key not in known:
+            raise CampaignError(f"{file}: unknown key {where + '.' if where else ''}{key} (known: {', '.join(known)})"
+                                + _did_you_mean(key, known))
+    return table
+
+
+def _kind(value: object) -> str:
+    return {str: "text", bool: "true/false", int: "an integer", float: "a number", list: "a list",
+            dict: "a table"}.get(type(value), type(value).__name__) + f" ({value!r})"
+
+
+def _number(value: object, where: str, file: str, *, positive: bool = False) -> float:
+    """A TOML integer or float (never text or true/false)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise CampaignError(f"{file}: {where} must be a number, not {_kind(value)}")
+    if positive and not value > 0:
+        raise CampaignError(f"{file}: {where} must be positive, not {value!r}")
+    return float(value)
+
+
+def _integer(value: object, where: str, file: str, *, minimum: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise CampaignError(f"{file}: {where} must be an integer, not {_kind(value)}")
+    if minimum is not None and value < minimum:
+        raise CampaignError(f"{file}: {where} must be at least {minimum}, not {value}")
+    return value
+
+
+def _text(value: object, where: str, file: str) -> str:
+    if not isinstance(value, str):
+        raise CampaignError(f"{file}: {where} must be text, not {_kind(value)}")
+    return value
+
+
+def _check_flight_axes(aircraft: str, variant: str, condition: str, loop: str, where: str, file: str) -> None:
+    """Refuse an unknown aircraft, variant, condition or loop before anything is run or written."""
+    from harness.flying import parse_loop
+    from models.aircraft import MODELS
+    from models.conditions import condition_for
+    if aircraft not in MODELS:
+        raise CampaignError(f"{file}: {where}aircraft {aircraft!r} is not one of {MODELS}"
+                            + _did_you_mean(str(aircraft), MODELS))
+    if variant not in CAMPAIGN_VARIANTS:
+        raise CampaignError(f"{file}: {where}variant {variant!r} is not one of {CAMPAIGN_VARIANTS}"
+                            + _did_you_mean(str(variant), CAMPAIGN_VARIANTS))
+    try:
+        condition_for(aircraft, condition)
+        parse_loop(loop)
+    except ValueError as exc:
+        raise CampaignError(f"{file}: {where}{exc}") from None
+
+
+def _allowed_plugins(d: dict, file: str) -> tuple[str, ...]:
+    """Plug-ins (``module:callable``) the campaign file's ``[plugins] allow`` and the environment enable."""
+    plugins = _known_keys(d.get("plugins", {}), PLUGIN_KEYS, "plugins", file)
+    allow = plugins.get("allow", [])
+    if not isinstance(allow, list) or not all(isinstance(x, str) for x in allow):
+        raise CampaignError(f"{file}: plugins.allow must be a list of 'module:callable' texts")
+    env = tuple(x.strip() for x in os.environ.get(PLUGINS_ENV, "").split(",") if x.strip())
+    return tuple(allow) + env
+
+
+def _method_factories(d: dict, methods: tuple[str, ...], file: str) -> tuple[tuple[str, str], ...]:
+    """``[method_factories]``: only plug-ins explicitly enabled (they are code the run imports and calls)."""
+    factories = d.get("method_factories", {})
+    if not isinstance(factories, dict):
+        raise CampaignError(f"{file}: method_factories must be a table")
+    allowed = _allowed_plugins(d, file)
+    for method, factory in factories.items():
+        _text(factory, f"method_factories.{method}", file)
+        if method not in methods:
+            raise CampaignError(f"{file}: method_factories.{method}: the grid has no method {method!r} "
+                                f"(methods: {', '.join(methods)})")
+        if ":" not in factory:
+            raise CampaignError(f"{file}: method_factories.{method} = {factory!r} must be 'module:callable'")
+        if factory not in allowed:
+            raise CampaignError(
+                f"{file}: method_factories.{method} = {factory!r} is code this run would import and call; "
+                f"enable it with [plugins] allow = [{factory!r}] in the campaign file or {PLUGINS_ENV}={factory} "
+                "(only for files you trust)")
+    return tuple(sorted(factories.items()))
 
 
 @dataclass(frozen=True)
@@ -206,6 +317,9 @@ def _list(d: dict, key: str, default: list, where: str) -> list:
         v = [v]
     if not v:
         raise CampaignError(f"{where}: '{key}' is empty")
+    for x in v:
+        if key != "loop" and not isinstance(x, str):
+            raise CampaignError(f"{where}: grid.{key} entries must be text, not {_kind(x)}")
     return v
 
 
@@ -217,7 +331,10 @@ def load_campaign(path: str | Path) -> Campaign:
     if not p.is_file():
         names = sorted(x.stem for x in BUILTIN_DIR.glob("*.toml"))
         raise CampaignError(f"no campaign file {path!s} (built-in campaigns: {', '.join(names)})")
-    text = p.read_text()
+    try:
+        text = p.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise CampaignError(f"{p}: not valid UTF-8 (byte {exc.start}); save the file as UTF-8") from None
     try:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -226,31 +343,28 @@ def load_campaign(path: str | Path) -> Campaign:
     for key in ("name", "seed", "realizations", "grid"):
         if key not in d:
             raise CampaignError(f"{where}: missing key '{key}'")
-    grid = d["grid"]
-    flight_defaults = d.get("flight", {})
+    _known_keys(d, TOP_KEYS, "", where)
+    grid = _known_keys(d["grid"], GRID_KEYS, "grid", where)
+    flight_defaults = _known_keys(d.get("flight", {}), FLIGHT_DEFAULT_KEYS, "flight", where)
+    name = _text(d["name"], "name", where)
+    description = _text(d.get("description", ""), "description", where)
+    seed = _integer(d["seed"], "seed", where, minimum=0)
+    realizations = _integer(d["realizations"], "realizations", where, minimum=1)
+    if not isinstance(d.get("combine", False), bool):
+        raise CampaignError(f"{where}: combine must be true or false, not {_kind(d['combine'])}")
     truth = d.get("truth", "local")
     if truth not in ("local", "fit"):
         raise CampaignError(f"{where}: truth must be 'local' or 'fit', not {truth!r}")
 
     mdefs = {}
-    for name, spec in d.get("maneuvers", {}).items():
-        spec = dict(spec)
-        kind = spec.pop("kind", name)
-        base = {k: spec.pop(k) for k in ("surface", "amplitude_deg", "unit_pulse_s") if k in spec}
-        mdefs[name] = ManeuverDef(name, kind, **base, options=tuple(sorted(spec.items())))
+    for mname, spec in _known_keys(d.get("maneuvers", {}), tuple(d.get("maneuvers", {})), "maneuvers",
+                                   where).items():
+        mdefs[mname] = _maneuver_def(mname, spec, where)
     maneuvers = [mdefs.get(m) or ManeuverDef(m, m) for m in _list(grid, "maneuver", ["2-1-1-2"], where)]
 
     ndefs = {}
-    for name, spec in d.get("noise", {}).items():
-        spec = dict(spec)
-        if spec.get("preset", "none") not in PRESETS:
-            raise CampaignError(f"{where}: noise.{name}.preset must be one of {PRESETS}")
-        if spec.get("apply_to", "both") not in APPLY_TO:
-            raise CampaignError(f"{where}: noise.{name}.apply_to must be one of {APPLY_TO}")
-        ndefs[name] = NoiseDef(name, spec.get("preset", "none"), float(spec.get("scale", 1.0)),
-                               spec.get("apply_to", "both"),
-                               tuple(sorted((k, float(v)) for k, v in spec.get("output", {}).items())),
-                               tuple(float(x) for x in spec.get("flight_scales", ())))
+    for nname, spec in d.get("noise", {}).items():
+        ndefs[nname] = _noise_def(nname, spec, where)
     noises = []
     for n in _list(grid, "noise", ["none"], where):
         if n in ndefs:
@@ -261,11 +375,22 @@ def load_campaign(path: str | Path) -> Campaign:
             raise CampaignError(f"{where}: grid.noise {n!r} is neither a preset {PRESETS} nor a [noise.{n}] table")
 
     duration = flight_defaults.get("duration_s")
-    rate = float(flight_defaults.get("sample_rate_hz", 50.0))
+    if duration is not None:
+        duration = _number(duration, "flight.duration_s", where, positive=True)
+    rate = _number(flight_defaults.get("sample_rate_hz", 50.0), "flight.sample_rate_hz", where, positive=True)
     if "flights" in d:
         # An explicit list of flights replaces the product of the grid's flight axes.
         flights = []
+        if not isinstance(d["flights"], list):
+            raise CampaignError(f"{where}: flights must be a list of [[flights]] tables")
         for i, f in enumerate(d["flights"]):
+            _known_keys(f, FLIGHT_KEYS, f"flights[{i}]", where)
+            if "duration_s" in f:
+                _number(f["duration_s"], f"flights[{i}].duration_s", where, positive=True)
+            _check_flight_axes(_text(f.get("aircraft", "f16"), f"flights[{i}].aircraft", where),
+                               _text(f.get("variant", "nominal"), f"flights[{i}].variant", where),
+                               _text(f.get("condition", "seed-5deg"), f"flights[{i}].condition", where),
+                               str(f.get("loop", "open")), f"flights[{i}].", where)
             m = f.get("maneuver", "2-1-1-2")
             flights.append(FlightKey(f.get("aircraft", "f16"), f.get("variant", "nominal"),
                                      f.get("condition", "seed-5deg"), mdefs.get(m) or ManeuverDef(m, m),
@@ -277,6 +402,10 @@ def load_campaign(path: str | Path) -> Campaign:
                             _list(grid, "aircraft", ["f16"], where), _list(grid, "variant", ["nominal"], where),
                             _list(grid, "condition", ["seed-5deg"], where), maneuvers,
                             [str(x) for x in _list(grid, "loop", ["open"], where)]))
+        for f in flights:
+            _check_flight_axes(f.aircraft, f.variant, f.condition, f.loop, "grid.", where)
+    for f in flights:
+        _check_maneuver_kind(f.maneuver, where)
     from estimators.methods import METHODS
     combine = bool(d.get("combine", False))
     allowed = COMBINED_METHODS if combine else METHODS
@@ -296,17 +425,87 @@ def load_campaign(path: str | Path) -> Campaign:
     except ValueError as exc:
         raise CampaignError(f"{where}: {exc}") from None
     method_options = []
+    if not isinstance(d.get("method_options", {}), dict):
+        raise CampaignError(f"{where}: method_options must be a table of [method_options.METHOD] tables")
     for m, opts in d.get("method_options", {}).items():
+        if not isinstance(opts, dict):
+            raise CampaignError(f"{where}: method_options.{m} must be a table")
         if m not in METHODS + COMBINED_METHODS:
             raise CampaignError(f"{where}: method_options.{m}: unknown method")
         bad = set(opts) - {"frequencies", "detrend", "max_lag"}
         if bad:
             raise CampaignError(f"{where}: method_options.{m}: unknown option(s) {sorted(bad)} "
                                 "(frequencies, detrend, max_lag)")
+        _check_method_options(m, opts, where)
         method_options.append((m, tuple(sorted(opts.items()))))
-    return Campaign(name=d["name"], description=d.get("description", ""), seed=int(d["seed"]),
-                    realizations=int(d["realizations"]), truth=truth, flights=flights, noises=tuple(noises),
+    return Campaign(name=name, description=description, seed=seed,
+                    realizations=realizations, truth=truth, flights=flights, noises=tuple(noises),
                     methods=methods, errors=errors, equations=equations, path=str(p),
                     text_hash=hashlib.sha256(text.encode()).hexdigest(), extra=d.get("report", {}),
                     method_options=tuple(method_options), combine=combine,
-                    method_factories=tuple(sorted(d.get("method_factories", {}).items())))
+                    method_factories=_method_factories(d, methods, where))
+
+
+def _maneuver_def(name: str, spec: object, file: str) -> ManeuverDef:
+    """``[maneuvers] NAME = {kind = ..., surface = ..., ...}``: keys of :func:`maneuvers.inputs.make_input`."""
+    import inspect
+
+    from maneuvers.inputs import make_input
+    known = tuple(inspect.signature(make_input).parameters) + ("gap_s",)
+    spec = dict(_known_keys(spec, known, f"maneuvers.{name}", file))
+    kind = _text(spec.pop("kind", name), f"maneuvers.{name}.kind", file)
+    base = {}
+    for key in ("amplitude_deg", "unit_pulse_s"):
+        if key in spec:
+            base[key] = _number(spec.pop(key), f"maneuvers.{name}.{key}", file)
+    if "surface" in spec:
+        base["surface"] = _text(spec.pop("surface"), f"maneuvers.{name}.surface", file)
+    for key, value in spec.items():
+        if key != "phases":
+            _number(value, f"maneuvers.{name}.{key}", file)
+    return ManeuverDef(name, kind, **base, options=tuple(sorted(spec.items())))
+
+
+def _check_maneuver_kind(m: ManeuverDef, file: str) -> None:
+    from maneuvers.inputs import INPUT_KINDS
+    kinds = tuple(INPUT_KINDS) + ("three-axis", "lateral")
+    if m.kind.lower() not in kinds:
+        raise CampaignError(f"{file}: maneuver {m.name!r}: kind {m.kind!r} is not one of {kinds} "
+                            "(nor a table of [maneuvers])" + _did_you_mean(m.kind, kinds))
+
+
+def _noise_def(name: str, spec: object, file: str) -> NoiseDef:
+    """``[noise.NAME]``: a preset, scaled, applied to regressors, outputs or both, plus output noise."""
+    if not isinstance(spec, dict):
+        raise CampaignError(f"{file}: noise.{name} = {spec!r}: noise set-ups are tables [noise.NAME] with keys "
+                            f"{', '.join(NOISE_KEYS)}" + _did_you_mean(name, NOISE_KEYS))
+    spec = _known_keys(spec, NOISE_KEYS, f"noise.{name}", file)
+    if spec.get("preset", "none") not in PRESETS:
+        raise CampaignError(f"{file}: noise.{name}.preset must be one of {PRESETS}")
+    if spec.get("apply_to", "both") not in APPLY_TO:
+        raise CampaignError(f"{file}: noise.{name}.apply_to must be one of {APPLY_TO}")
+    output = spec.get("output", {})
+    if not isinstance(output, dict):
+        raise CampaignError(f"{file}: noise.{name}.output must be a table like {{ Cm = 0.0005 }}")
+    scales = spec.get("flight_scales", [])
+    if not isinstance(scales, list):
+        raise CampaignError(f"{file}: noise.{name}.flight_scales must be a list of numbers")
+    return NoiseDef(name, spec.get("preset", "none"), _number(spec.get("scale", 1.0), f"noise.{name}.scale", file),
+                    spec.get("apply_to", "both"),
+                    tuple(sorted((k, _number(v, f"noise.{name}.output.{k}", file)) for k, v in output.items())),
+                    tuple(_number(x, f"noise.{name}.flight_scales", file) for x in scales))
+
+
+def _check_method_options(method: str, opts: dict, file: str) -> None:
+    """Option values the estimator can use (parsed now, not in a worker mid-run)."""
+    from estimators.methods import parse_frequencies
+    where = f"method_options.{method}"
+    if "frequencies" in opts:
+        try:
+            parse_frequencies(_text(opts["frequencies"], f"{where}.frequencies", file))
+        except ValueError as exc:
+            raise CampaignError(f"{file}: {where}.frequencies: {exc}") from None
+    if "detrend" in opts and opts["detrend"] not in ("endpoints", "lstsq"):
+        raise CampaignError(f"{file}: {where}.detrend must be 'endpoints' or 'lstsq', not {opts['detrend']!r}")
+    if "max_lag" in opts:
+        _integer(opts["max_lag"], f"{where}.max_lag", file, minimum=0)

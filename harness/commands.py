@@ -4,7 +4,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from harness.atomic import write_json_atomic
+from harness.atomic import check_output_file, write_json_atomic
+from harness.errors import OptionError
 
 
 def cmd_fly(args: argparse.Namespace) -> int:
@@ -12,6 +13,7 @@ def cmd_fly(args: argparse.Namespace) -> int:
     from harness.recording_io import write_recording
     from maneuvers.fly import fly_maneuver
 
+    check_output_file(args.out, "--out recording")
     spec = spec_from_args(args)
     rec = fly_maneuver(spec)
     path = write_recording(rec, args.out)
@@ -25,6 +27,8 @@ def cmd_truth(args: argparse.Namespace) -> int:
     from maneuvers.fly import default_truth, truth_table
     from models.aircraft import Aircraft
 
+    if args.json:
+        check_output_file(args.json, "--json file")
     aircraft = Aircraft(args.aircraft, args.variant)
     truth = default_truth(aircraft, args.condition)
     print(truth_table(truth))
@@ -52,6 +56,7 @@ def cmd_truth(args: argparse.Namespace) -> int:
 def cmd_import(args: argparse.Namespace) -> int:
     from harness.recording_io import read_recording, write_recording
 
+    check_output_file(args.out, "--out recording")
     rec = read_recording(args.file)
     path = write_recording(rec, args.out)
     print(f"imported {args.file}: {rec.n} samples at {1 / rec.dt:g} Hz, channels "
@@ -81,10 +86,18 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     from estimators.regressors import DataOptions, Equation
     from harness.recording_io import read_recording
 
+    if args.json:
+        check_output_file(args.json, "--json file")  # before the fit, not after it was printed
+    if args.max_lag is not None and args.max_lag < 0:
+        raise OptionError(f"--max-lag must be at least 0, not {args.max_lag}")
+    try:
+        freqs = parse_frequencies(args.frequencies) if args.frequencies else None
+    except ValueError as exc:
+        raise OptionError(f"--frequencies {args.frequencies!r} is not a band F0:DF:F1 in Hz, a comma list of "
+                          f"frequencies, auto, eq18 or sidpac ({exc})") from None
     rec = read_recording(args.recording)
     equation = Equation.parse(args.dependent, args.regressors, bias=not args.no_bias and args.method != "ee-freq")
     data = DataOptions(angular_acceleration=args.angular_acceleration, reference=args.reference)
-    freqs = parse_frequencies(args.frequencies) if args.frequencies else None
     estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
                                detrend=args.detrend, data=data)
     fit = estimator.fit(rec, equation)
@@ -101,10 +114,12 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     from harness.runner import run_campaign
     from harness.scores import format_scores
 
+    if args.workers is not None and args.workers < 1:
+        raise OptionError(f"--workers must be at least 1, not {args.workers} (leave it out to use every core)")
     campaign = load_campaign(args.file)
     if args.realizations is not None:
         if args.realizations < 1:
-            raise ValueError("--realizations must be at least 1")
+            raise OptionError(f"--realizations must be at least 1, not {args.realizations}")
         campaign = campaign.with_realizations(args.realizations)
     run = run_campaign(campaign, args.out, scheduler=args.scheduler, workers=args.workers, cache_dir=args.cache,
                        history_dir=args.history, progress=not args.quiet)
@@ -115,3 +130,14 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     print(format_scores(run.scores))
     print(f"\nwrote {run.out_dir / 'results.parquet'}, {run.out_dir / 'scores.parquet'}, {run.out_dir / 'run.json'}")
     return 0
+
+
+def cmd_diagnose(args: argparse.Namespace) -> int:
+    """``sidbench diagnose``: the diagnosis and its report (``reports.commands``, loaded by module path:
+    the harness never imports the reports package), with OUT marked incomplete until both are written."""
+    import importlib
+
+    from harness.diagnosis.run import incomplete_marker
+
+    with incomplete_marker(Path(args.out)):
+        return int(importlib.import_module("reports.commands").cmd_diagnose(args) or 0)

@@ -7,8 +7,14 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing
+import os
+import signal
+import threading
+import time
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any
+
+from harness.errors import OptionError
 
 
 class Executor:
@@ -26,8 +32,33 @@ class Executor:
     def __enter__(self) -> "Executor":
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()
+        else:
+            self.close()
+
+    def abort(self) -> None:
+        """Stop at once (an interruption or an error): unfinished work is dropped."""
         self.close()
+
+
+ORPHAN_POLL_S = 0.5
+"""How often a pool worker checks that the process that started it is still alive."""
+
+
+def _exit_when_orphaned(parent_pid: int) -> None:
+    while os.getppid() == parent_pid:
+        time.sleep(ORPHAN_POLL_S)
+    os._exit(1)  # the parent is gone (kill -9): nobody will read our results
+
+
+def _worker_init(parent_pid: int) -> None:
+    """In each pool worker: leave Ctrl-C to the parent (no traceback per worker), and exit when
+    the parent dies instead of living on as an orphan."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_when_orphaned, args=(parent_pid,), daemon=True,
+                     name="sidbench-orphan-watch").start()
 
 
 class LocalPool(Executor):
@@ -36,7 +67,8 @@ class LocalPool(Executor):
     def __init__(self, workers: int) -> None:
         self.workers = workers
         self.description = f"local process pool, {workers} workers"
-        self.pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"))
+        self.pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                                           initializer=_worker_init, initargs=(os.getpid(),))
 
     def imap_unordered(self, fn, items, *args):
         futures = {self.pool.submit(fn, item, *args): item for item in items}
@@ -45,6 +77,14 @@ class LocalPool(Executor):
 
     def close(self) -> None:
         self.pool.shutdown(wait=True, cancel_futures=True)
+
+    def abort(self) -> None:
+        processes = list((getattr(self.pool, "_processes", None) or {}).values())
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        for proc in processes:
+            proc.terminate()
+        for proc in processes:
+            proc.join(timeout=5)
 
 
 class DaskExecutor(Executor):
@@ -79,6 +119,8 @@ class DaskExecutor(Executor):
 
 def make_executor(scheduler: str | None, workers: int) -> Executor:
     """Serial for one worker without a scheduler, a process pool otherwise, Dask when asked."""
+    if workers < 1:
+        raise OptionError(f"--workers must be at least 1, not {workers}")
     if scheduler:
         return DaskExecutor(scheduler, workers)
     if workers <= 1:

@@ -1,7 +1,9 @@
 """Running a campaign: resumable, on any executor, with identical numbers everywhere."""
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
+import fcntl
 import hashlib
 import json
 import os
@@ -11,8 +13,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from harness.atomic import write_json_atomic
-from harness.campaign import Campaign, Task
+from harness.atomic import ensure_folder, write_json_atomic
+from harness.campaign import Campaign, CampaignError, Task
+from harness.errors import Interrupted, OptionError
 from harness.executors import make_executor
 from harness.progress import Progress
 from harness.scores import score
@@ -36,18 +39,52 @@ def _task_path(out_dir: Path, task: Task) -> Path:
     return out_dir / "tasks" / f"{task.task_id}.parquet"
 
 
+def _finished_tasks(out_dir: Path) -> list[Path]:
+    tasks = out_dir / "tasks"
+    return sorted(tasks.glob("*.parquet")) if tasks.is_dir() else []
+
+
 def _check_out_dir(out_dir: Path, campaign: Campaign) -> None:
-    """Refuse to mix two different campaigns' tasks in one folder."""
+    """Refuse to mix two different campaigns' tasks in one folder. A folder without a finished
+    task holds nothing to protect: its marker is simply replaced."""
     marker = out_dir / "campaign.json"
     ident = {"name": campaign.name, "sha256": campaign.text_hash}
-    if marker.is_file():
-        old = json.loads(marker.read_text())
+    if marker.is_file() and _finished_tasks(out_dir):
+        try:
+            old = json.loads(marker.read_text())
+        except (ValueError, UnicodeDecodeError):
+            old = {}
         if old.get("sha256") != campaign.text_hash:
-            raise ValueError(f"{out_dir} holds results of campaign {old.get('name')!r} from a different campaign "
-                             f"file (sha256 {old.get('sha256', '')[:12]} vs {campaign.text_hash[:12]}); "
-                             "use another --out folder or delete it")
+            raise CampaignError(f"{out_dir} holds results of campaign {old.get('name')!r} from a different campaign "
+                                f"file (sha256 {str(old.get('sha256', ''))[:12]} vs {campaign.text_hash[:12]}); "
+                                "use another --out folder or delete it")
     else:
         write_json_atomic(marker, ident)
+
+
+def _remove_stale_temporaries(out_dir: Path) -> int:
+    """Temporary files a killed run left in ``tasks/`` (this run holds the folder's lock)."""
+    tasks = out_dir / "tasks"
+    stale = list(tasks.glob(".*.tmp")) if tasks.is_dir() else []
+    for p in stale:
+        p.unlink(missing_ok=True)
+    return len(stale)
+
+
+@contextlib.contextmanager
+def _folder_lock(out_dir: Path):
+    """One run at a time per output folder (the lock goes with the process, even on kill -9)."""
+    with open(out_dir / ".lock", "a+b") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise CampaignError(f"{out_dir}: another sidbench campaign is running in this folder") from None
+        yield
+
+
+def _resume_hint(out_dir: Path) -> str:
+    return (f"finished tasks are kept in {out_dir / 'tasks'}; run the same command again to resume "
+            "where it stopped")
 
 
 def run_campaign(campaign: Campaign, out_dir: str | Path, *, scheduler: str | None = None,
@@ -60,9 +97,21 @@ def run_campaign(campaign: Campaign, out_dir: str | Path, *, scheduler: str | No
     rest without recomputing anything, and the final tables are identical to an
     uninterrupted run's.
     """
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    if workers is not None and workers < 1:
+        raise OptionError(f"--workers must be at least 1, not {workers}")
+    out_dir = ensure_folder(out_dir, "output folder")
+    try:
+        with _folder_lock(out_dir):
+            return _run_locked(campaign, out_dir, scheduler=scheduler, workers=workers, cache_dir=cache_dir,
+                               history_dir=history_dir, progress=progress)
+    except KeyboardInterrupt:
+        raise Interrupted(_resume_hint(out_dir)) from None
+
+
+def _run_locked(campaign: Campaign, out_dir: Path, *, scheduler: str | None, workers: int | None,
+                cache_dir: str | Path | None, history_dir: str | Path | None, progress: bool) -> CampaignRun:
     _check_out_dir(out_dir, campaign)
+    _remove_stale_temporaries(out_dir)
     cache = str(Path(cache_dir) if cache_dir else DEFAULT_CACHE)
     workers = workers or max(1, os.cpu_count() or 1)
     tasks = campaign.tasks()

@@ -201,11 +201,21 @@ def import_sidpac(path: str | Path) -> Recording:
     source = str(path)
     if not path.is_file():
         raise FileNotFoundError(f"{source}: no such SIDPAC file")
-    mat = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
+    mat = _load_mat(path)
     fds = mat.get("fds")
     if fds is None or not hasattr(fds, "varlab"):
         raise RecordingError("no SIDPAC 'fds' struct with 'varlab'", source=source, key="fds",
                              rule="not-sidpac")
+    for field_name in ("varunits",):
+        if not hasattr(fds, field_name):
+            raise RecordingError(f"the SIDPAC 'fds' struct has no {field_name!r} field (units of the fdata columns)",
+                                 source=source, key=f"fds.{field_name}", rule="not-sidpac")
+    if "fdata" not in mat and not hasattr(fds, "fdata"):
+        raise RecordingError("no 'fdata' matrix (neither a variable nor a field of fds)", source=source,
+                             key="fdata", rule="not-sidpac")
+    if "t" not in mat and not hasattr(fds, "t"):
+        raise RecordingError("no time vector 't' (neither a variable nor a field of fds)", source=source,
+                             key="t", rule="not-sidpac")
     fdata = np.asarray(mat["fdata"] if "fdata" in mat else getattr(fds, "fdata", []), dtype=np.float64)
     t = np.asarray(mat["t"] if "t" in mat else getattr(fds, "t", []), dtype=np.float64).ravel()
     labels = [_text(x).strip() for x in np.atleast_1d(fds.varlab)]
@@ -410,6 +420,24 @@ def import_sidpac(path: str | Path) -> Recording:
     }
     frame = to_canonical(pd.DataFrame(channels), source)
     return Recording(frame, meta, name=path.stem).validate(source)
+
+
+def _load_mat(path: Path) -> dict[str, Any]:
+    """The variables of a MATLAB v5 file, or an error naming the file and what is wrong with it."""
+    source = str(path)
+    if path.stat().st_size == 0:
+        raise RecordingError("file is empty", source=source, key="file", rule="bad-mat")
+    try:
+        return scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
+    except NotImplementedError:
+        raise RecordingError("MATLAB v7.3 (HDF5) files are not supported; save it from MATLAB with "
+                             "save(FILE, '-v7')", source=source, key="file", rule="unsupported-mat") from None
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - scipy's parser raises many kinds on damaged bytes
+        text = " ".join(str(exc).split())[:160] or type(exc).__name__
+        raise RecordingError(f"not a readable MATLAB v5 .mat file (empty, truncated or damaged: {text})",
+                             source=source, key="file", rule="bad-mat") from None
 
 
 def _col_name(name: str) -> str:

@@ -49,7 +49,8 @@ def test_nightly_gate_passes_clean_and_fails_on_a_planted_regression(tmp_path, c
     moved = pd.read_parquet(tmp_path / "night2" / "gates.parquet")
     assert (moved["kind"] == "movement").any() and moved["passed"].all()
     # plant a 10 % bias in the frequency-domain estimator
-    planted = NIGHTLY_SMALL + '\n[method_factories]\n"ee-freq" = "planted:biased_frequency"\n'
+    planted = (NIGHTLY_SMALL + '\n[plugins]\nallow = ["planted:biased_frequency"]\n'
+               '\n[method_factories]\n"ee-freq" = "planted:biased_frequency"\n')
     code, out = _run(tmp_path, "night3", planted, capsys)
     assert code == 1
     assert "GATE FAILED" in out.err and "ee-freq" in out.err and "CZ_alpha" in out.err

@@ -2,6 +2,7 @@
 its output folder: findings.json, series/*.parquet, model/ (the augmented JSBSim aircraft)."""
 from __future__ import annotations
 
+import contextlib
 import json
 import time
 import xml.etree.ElementTree as ET
@@ -368,6 +369,48 @@ def _with_recorded_mass(aircraft: Aircraft, rec) -> Aircraft:
     return Aircraft(str(root / "aircraft" / name / f"{name}.xml"))
 
 
+INCOMPLETE = "INCOMPLETE"
+"""Marker file in a diagnosis folder while it is being written; a folder holding it was interrupted."""
+_open_markers: dict[Path, int] = {}
+
+
+def check_out_folder(out: str | Path) -> Path:
+    """The diagnosis output folder, created; an error naming the file in the way if it cannot be."""
+    from harness.atomic import ensure_folder
+    try:
+        return ensure_folder(out, "--out folder")
+    except ValueError as exc:
+        raise DiagnosisError(str(exc)) from None
+
+
+@contextlib.contextmanager
+def incomplete_marker(out: Path):
+    """Mark ``out`` incomplete while the body runs; the outermost user removes the mark on success
+    (so the command line keeps it until the report, written after :func:`diagnose`, is there too)."""
+    key = Path(out).resolve()
+    outer = key not in _open_markers
+    created = not key.exists()
+    if outer:
+        check_out_folder(key)
+        write_text_atomic(key / INCOMPLETE, "sidbench diagnose was writing this folder and did not finish "
+                                            "(interrupted or failed): its contents are incomplete. Run it again.\n")
+    _open_markers[key] = _open_markers.get(key, 0) + 1
+    try:
+        yield key
+    except BaseException:
+        if outer and [p.name for p in key.iterdir()] == [INCOMPLETE]:  # nothing written yet: leave nothing
+            (key / INCOMPLETE).unlink(missing_ok=True)
+            if created:
+                key.rmdir()
+        raise
+    finally:
+        _open_markers[key] -= 1
+        if not _open_markers[key]:
+            del _open_markers[key]
+    if outer:
+        (key / INCOMPLETE).unlink(missing_ok=True)
+
+
 def diagnose(model: str, recording: str | Path, out: str | Path, validation: str | Path | None = None, *,
              mass: str = "model") -> dict:
     """Diagnose ``recording`` against ``model``; write ``out``; return findings.json's content.
@@ -380,8 +423,12 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
     DiagnosisError
         For an unknown model; recording, trim and flight errors name their cause themselves.
     """
+    with incomplete_marker(Path(out)) as folder:
+        return _diagnose(model, recording, folder, validation, mass=mass)
+
+
+def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str) -> dict:
     t0 = time.perf_counter()
-    out = Path(out)
     aircraft = _aircraft(model)
     rec = read_recording(recording)
     if mass == "recording":
