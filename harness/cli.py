@@ -127,7 +127,7 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--recording", required=True, help="identification recording (.csv beside .meta.json, or .parquet)")
     g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
     g.add_argument("--out", required=True, help="output folder")
-    g.set_defaults(func="reports.commands:cmd_diagnose")
+    g.set_defaults(func="harness.commands:cmd_diagnose")
 
     gg = sub.add_parser("gallery", help="write the concealed-effect recordings (identification + validation)",
                         description="Fly the F-16 with one hidden effect per case, add the realistic noise layer "
