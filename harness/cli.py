@@ -64,13 +64,16 @@ def _parser() -> argparse.ArgumentParser:
                    help="comma list: alpha, beta, qhat, phat, rhat, de, da, dr, dV, alphadot_hat, "
                         "products a*b and powers a^2 ...")
     e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe"])
-    e.add_argument("--errors", default="conventional", choices=["conventional", "colored"],
-                   help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40)")
+    e.add_argument("--errors", default=None, choices=["conventional", "colored"],
+                   help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40); "
+                        "default colored for ee-smooth, conventional for ee-time")
     e.add_argument("--max-lag", type=int, default=None, help="colored errors: largest lag (default: all)")
     e.add_argument("--frequencies", default=None,
-                   help="ee-freq band F0:DF:F1 in Hz, or a comma list (default 0.20:0.04:1.20, Eq. 18)")
-    e.add_argument("--detrend", default="endpoints", choices=["endpoints", "lstsq"],
-                   help="ee-freq detrending: line through the end points (default) or least-squares line")
+                   help="ee-freq band: auto (default: the seed's rule, 2/T to 1.2 Hz by 0.04 Hz), sidpac or "
+                        "eq18 (Eq. 18, 0.20:0.04:1.20), F0:DF:F1 in Hz, or a comma list")
+    e.add_argument("--detrend", default="lstsq", choices=["lstsq", "endpoints"],
+                   help="ee-freq detrending: least-squares line (default) or the line through the end points "
+                        "(SIDPAC's; with --frequencies sidpac, SIDPAC's convention)")
     e.add_argument("--no-bias", action="store_true", help="no bias term (ee-freq never has one)")
     e.add_argument("--reference", default="trim", choices=["trim", "first", "none"],
                    help="regressors as perturbations from trim (default; raw where no trim is known), "
