@@ -260,3 +260,17 @@ def test_thrust_follows_the_format_and_says_what_it_assumed(three_axis_exact):
     assert not regression_data(nothing, Equation("CZ", ("alpha",))).assumptions
     freq = make_estimator("ee-freq").fit(nothing, Equation("CX", ("alpha", "qhat", "de"), bias=False))
     assert freq.assumptions == unknown.assumptions
+
+
+def test_estimate_command_defaults_and_the_sidpac_options(tmp_path, shared_dir):
+    src = shared_dir / "data" / "sidpac" / "totter_f1_017_data.mat"
+    base = ["estimate", "--recording", str(src), "--dependent", "Cn", "--regressors", "beta,phat,rhat,da,dr"]
+    out = tmp_path / "smooth.json"
+    assert main(base + ["--method", "ee-smooth", "--json", str(out)]) == 0
+    js = json.loads(out.read_text())
+    assert js["errors"] == "colored" and "assumptions" in js
+    assert any("strongly coloured" in w for w in js["warnings"])
+    out = tmp_path / "sidpac.json"
+    assert main(base + ["--method", "ee-freq", "--frequencies", "sidpac", "--detrend", "endpoints",
+                        "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["parameters"][0]["estimate"] == pytest.approx(0.083647, rel=5e-5)
