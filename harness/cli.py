@@ -39,7 +39,9 @@ def _parser() -> argparse.ArgumentParser:
                                    "best linear fit over the default maneuvers' excursion.")
     t.add_argument("--aircraft", default="f16", choices=["f16", "737"])
     t.add_argument("--variant", default="nominal", choices=["nominal", "exact-truth", "unstable"])
-    t.add_argument("--condition", default=None, help="flight condition name (default: the aircraft's first)")
+    t.add_argument("--condition", default=None,
+                   help="flight condition by name (default: the aircraft's first) or by value, "
+                        "h=<ft>,V=<ft/s true airspeed> (e.g. h=10000,V=427.4)")
     t.add_argument("--json", default=None, help="write the derivatives to this JSON file")
     t.add_argument("--check-linearization", action="store_true",
                    help="also compare with jsbsim.FGLinearization and print the relative differences")
