@@ -227,9 +227,100 @@ def diagnosis_rows(repeat: int) -> list[BenchRow]:
     return out
 
 
+LARGE_ROWS = 10_000_000
+
+
+def large_recording_columns(n: int) -> dict:
+    """Twenty channels of a synthetic flight at 100 Hz (the measured angular accelerations
+    among them, as the format allows), deterministic."""
+    import numpy as np
+    rng = np.random.default_rng(0)
+    t = np.arange(n) * 0.01
+    w = 0.9 * t
+    noise = lambda s: s * rng.standard_normal(n)  # noqa: E731
+    return {
+        "t_s": t, "V_fps": 420.0 + noise(0.5), "alpha_rad": 0.08 + 0.02 * np.sin(w) + noise(1e-4),
+        "beta_rad": noise(1e-3), "p_rps": noise(1e-2), "q_rps": 0.018 * np.cos(w) + noise(1e-4),
+        "r_rps": noise(1e-2), "phi_rad": noise(1e-2), "theta_rad": 0.08 + 0.02 * np.sin(w),
+        "psi_rad": noise(1e-2), "ax_g": noise(1e-2), "ay_g": noise(1e-2), "az_g": -1.0 + noise(1e-2),
+        "de_rad": 0.017 * np.sign(np.sin(0.5 * t)) + noise(1e-4), "da_rad": noise(1e-3), "dr_rad": noise(1e-3),
+        "qbar_psf": 150.0 + noise(0.2), "pdot_rps2": noise(1e-2), "qdot_rps2": -0.0162 * np.sin(w) + noise(1e-3),
+        "rdot_rps2": noise(1e-2),
+    }
+
+
+LARGE_META = {"format": "flight-recording/1", "aircraft": "F-16 (synthetic)",
+              "geometry": {"S_ft2": 300.0, "b_ft": 30.0, "cbar_ft": 11.32},
+              "mass": {"mass_slug": 647.2, "Ix_slugft2": 9496.0, "Iy_slugft2": 55814.0, "Iz_slugft2": 63100.0,
+                       "Ixz_slugft2": 982.0},
+              "source": "sidbench bench: synthetic large recording"}
+
+
+def write_large_recording(folder, n: int = LARGE_ROWS) -> dict:
+    """``big.csv`` (+ ``big.meta.json``) and ``big.parquet`` of ``n`` rows in ``folder`` (written with
+    pyarrow's writers, shortest round-trip floats: the bench's input, not the project's writer)."""
+    import json
+    from pathlib import Path
+
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+
+    from harness.recording_io import PARQUET_META_KEY
+    folder = Path(folder)
+    table = pa.table(large_recording_columns(n))
+    pacsv.write_csv(table, folder / "big.csv")
+    (folder / "big.meta.json").write_text(json.dumps(LARGE_META))
+    pq.write_table(table.replace_schema_metadata({PARQUET_META_KEY: json.dumps(LARGE_META).encode()}),
+                   folder / "big.parquet")
+    return {"csv": folder / "big.csv", "parquet": folder / "big.parquet"}
+
+
+_MEASURED_ESTIMATE = """
+import json, resource, sys, time
+t0 = time.perf_counter()
+from harness.cli import main
+code = main(["estimate", "--recording", sys.argv[1], "--dependent", "Cm", "--regressors", "alpha,qhat,de",
+             "--method", "ee-time"])
+print(json.dumps({"code": code, "seconds": time.perf_counter() - t0,
+                  "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def measured_estimate(path) -> dict:
+    """``sidbench estimate`` (ee-time, Cm = alpha + qhat + de) in a process of its own: wall seconds
+    (imports included) and peak resident memory from its own ``getrusage`` (ru_maxrss)."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    out = subprocess.run([sys.executable, "-c", _MEASURED_ESTIMATE, str(path)], cwd=root, capture_output=True,
+                         text=True, check=True)
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    if result["code"] != 0:
+        raise RuntimeError(f"estimate of {path} failed: {out.stderr}")
+    return result
+
+
+def large_recording_rows(n: int = LARGE_ROWS) -> list[BenchRow]:
+    """A 10 M-row, 20-channel recording (CSV and Parquet) read, validated and estimated."""
+    import tempfile
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = write_large_recording(tmp, n)
+        for kind in ("csv", "parquet"):
+            r = measured_estimate(paths[kind])
+            label = f"estimate ee-time Cm from a {n / 1e6:.0f} M-row, 20-channel {kind.upper()}"
+            out.append(BenchRow(label, r["seconds"], "s",
+                                f"peak {r['peak_mb']:.0f} MB (ru_maxrss); bar < 60 s and < 4 GB"))
+    return out
+
+
 def rows(repeat: int) -> list[BenchRow]:
     """All benchmark rows, in order."""
-    return flight_rows(repeat) + estimator_rows(repeat) + campaign_rows() + report_rows() + diagnosis_rows(repeat)
+    return (flight_rows(repeat) + estimator_rows(repeat) + campaign_rows() + report_rows() + diagnosis_rows(repeat)
+            + large_recording_rows())
 
 
 def format_rows(table: list[BenchRow]) -> str:

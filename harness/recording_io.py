@@ -252,67 +252,105 @@ def _non_numeric_error(path: Path, header: list[str], message: str) -> Recording
     )
 
 
-def _drop_trailing_blank_rows(table: pa.Table, path: Path) -> pa.Table:
-    """Blank lines at the end are ignored; a blank line among the data is refused."""
-    if table.num_columns == 0 or table.column(0).null_count == 0:
-        return table
-    empty = np.asarray(pc.is_null(table.column(0)))
-    for column in table.columns[1:]:
-        empty &= np.asarray(pc.is_null(column))
-    blank = np.flatnonzero(empty)
-    if blank.size == 0:
-        return table
-    trailing = table.num_rows - blank.size
-    if blank[0] < trailing:
-        row = int(blank[0]) + 1
-        raise RecordingError(f"{_line_text(row)} is blank (a blank line among the data)", source=str(path),
-                             key=f"line {row + 1}", rule="length-mismatch")
-    return table.slice(0, trailing)
+class _Columns:
+    """Float64 NumPy columns filled batch by batch (memory: the data once, plus one batch).
+
+    The capacity is a row count estimated up front (exact for Parquet); it grows by a quarter
+    when exceeded and is trimmed in place at the end.
+    """
+
+    def __init__(self, names: list[str], capacity: int, source: str) -> None:
+        self.names, self.source = names, source
+        self.capacity = max(1, capacity)
+        self.arrays = [np.empty(self.capacity, dtype=np.float64) for _ in names]
+        self.n = 0
+        self.blank: list[np.ndarray] = []  # rows where every field is empty (blank lines)
+
+    def add(self, batch: pa.RecordBatch) -> None:
+        k = batch.num_rows
+        if self.n + k > self.capacity:
+            self.capacity = max(self.n + k, self.capacity + self.capacity // 4)
+            for a in self.arrays:
+                a.resize(self.capacity, refcheck=False)
+        self._check_nulls(batch)
+        for j, name in enumerate(self.names):
+            column = batch.column(j)
+            if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type)):
+                raise RecordingError(f"values must be numbers, the column holds {column.type}", source=self.source,
+                                     key=f"column {name!r}", rule="non-numeric")
+            self.arrays[j][self.n:self.n + k] = column.to_numpy(zero_copy_only=False)
+        self.n += k
+
+    def _check_nulls(self, batch: pa.RecordBatch) -> None:
+        if not any(c.null_count for c in batch.columns):
+            return
+        nulls = np.column_stack([np.asarray(pc.is_null(c)) for c in batch.columns])
+        every, some = nulls.all(axis=1), nulls.any(axis=1)
+        partial = np.flatnonzero(some & ~every)
+        if partial.size:
+            i = int(partial[0])
+            j = int(np.flatnonzero(nulls[i])[0])
+            raise RecordingError(f"empty value at {_line_text(self.n + i + 1)}", source=self.source,
+                                 key=f"column {self.names[j]!r}", rule="non-numeric")
+        self.blank.append(self.n + np.flatnonzero(every))
+
+    def finish(self) -> dict[str, np.ndarray]:
+        """The columns, blank lines at the end dropped; a blank line among the data is refused."""
+        blank = np.concatenate(self.blank) if self.blank else np.empty(0, dtype=np.int64)
+        n = self.n - blank.size
+        if blank.size and blank[0] < n:
+            row = int(blank[0]) + 1
+            raise RecordingError(f"{_line_text(row)} is blank (a blank line among the data)", source=self.source,
+                                 key=f"line {row + 1}", rule="length-mismatch")
+        for a in self.arrays:
+            a.resize(n, refcheck=False)
+        return dict(zip(self.names, self.arrays))
 
 
-def _read_csv_table(path: Path) -> pa.Table:
-    """Read a recording CSV with pyarrow (columnar, float64, correctly rounded parsing)."""
+_STREAM_BLOCK = 1 << 22
+
+
+def _csv_columns(path: Path) -> dict[str, np.ndarray]:
+    """Read a recording CSV with pyarrow's streaming reader (columnar, float64, correctly rounded)."""
     if path.stat().st_size == 0:
         raise RecordingError("file is empty; expected a header row", source=str(path), key="header",
                              rule="empty-file")
     header = _read_header(path)
+    canonical_names(header, str(path))  # names are checked before any data are read
     handler = _InvalidRows()
+    columns: _Columns | None = None
     try:
-        table = _arrow_csv(path, header, handler=handler)
+        reader = _arrow_csv_stream(path, header, handler)
+        for batch in reader:
+            if columns is None:  # rows per byte of the first block -> the whole file's row count
+                columns = _Columns(header, int(path.stat().st_size * batch.num_rows / _STREAM_BLOCK * 1.02) + 16,
+                                   str(path))
+            columns.add(batch)
     except pa.ArrowInvalid as exc:
         if handler.first is not None:
             raise _ragged_row_error(path, header, handler.first) from None
         raise _non_numeric_error(path, header, str(exc)) from None
-    return _drop_trailing_blank_rows(table, path)
+    return (columns or _Columns(header, 1, str(path))).finish()
 
 
-def _arrow_columns(table: pa.Table, source: str) -> dict[str, np.ndarray]:
-    """Float64 NumPy columns of ``table``, each Arrow column released once copied (peak memory
-    is the table plus one column, not twice the table)."""
-    names = list(table.column_names)
-    arrow = list(table.columns)
-    del table
-    out: dict[str, np.ndarray] = {}
-    for i, name in enumerate(names):
-        column, arrow[i] = arrow[i], None
-        if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type)):
-            raise RecordingError(f"values must be numbers, the column holds {column.type}", source=source,
-                                 key=f"column {name!r}", rule="non-numeric")
-        if column.null_count:
-            row = pc.index(pc.is_null(column), True).as_py() + 1
-            raise RecordingError(f"empty value at {row_label(row - 1)}", source=source,
-                                 key=f"column {name!r}", rule="non-numeric")
-        values = column.to_numpy() if column.num_chunks != 1 else np.array(column.chunk(0).to_numpy())
-        out[name] = values.astype(np.float64, copy=False)
-        del column
-    return out
+def _arrow_csv_stream(path: Path, header: list[str], handler: Any) -> pacsv.CSVStreamingReader:
+    return pacsv.open_csv(
+        path,
+        read_options=pacsv.ReadOptions(column_names=header, skip_rows=1, use_threads=False,
+                                       block_size=_STREAM_BLOCK),
+        parse_options=pacsv.ParseOptions(ignore_empty_lines=False, invalid_row_handler=handler),
+        convert_options=pacsv.ConvertOptions(
+            column_types={h: pa.float64() for h in header}, null_values=[""], strings_can_be_null=False,
+            quoted_strings_can_be_null=False),
+        memory_pool=pa.system_memory_pool(),
+    )
 
 
-def _frame_from_table(table: pa.Table, source: str) -> pd.DataFrame:
-    n = table.num_rows
-    names = list(table.column_names)
-    targets = canonical_names(names, source)  # names are checked before any data are converted
-    return frame_from_columns(convert_in_place(_arrow_columns(table, source), targets), n)
+def _frame(columns: dict[str, np.ndarray], source: str) -> pd.DataFrame:
+    """Canonical names and units, in place (the columns are given up), as a table without copies."""
+    n = len(next(iter(columns.values()))) if columns else 0
+    targets = canonical_names(list(columns), source)
+    return frame_from_columns(convert_in_place(columns, targets), n)
 
 
 # --------------------------------------------------------------------------------------
@@ -327,21 +365,26 @@ def _write_parquet_body(data: pd.DataFrame, meta_json: str, fh: IO[bytes]) -> No
     pq.write_table(table.replace_schema_metadata(metadata), fh)
 
 
-def _read_parquet(path: Path) -> tuple[pa.Table, dict[str, Any]]:
+def _read_parquet(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     source = str(path)
     try:
-        table = pq.read_table(path)
+        pf = pq.ParquetFile(path)
+        metadata = pf.schema_arrow.metadata or {}
+        if PARQUET_META_KEY not in metadata:
+            raise RecordingError(
+                f"Parquet schema metadata has no {PARQUET_META_KEY.decode()!r} entry",
+                source=source, key="meta", rule="missing-meta",
+            )
+        meta = _parse_meta(_decode_utf8(metadata[PARQUET_META_KEY], source, "embedded metadata"), source)
+        names = list(pf.schema_arrow.names)
+        canonical_names(names, source)
+        columns = _Columns(names, pf.metadata.num_rows, source)
+        for batch in pf.iter_batches(batch_size=1 << 16):
+            columns.add(batch)
     except (pa.ArrowException, OSError) as exc:
         raise RecordingError(f"not a readable Parquet file ({' '.join(str(exc).split())[:200]})", source=source,
                              key="file", rule="bad-parquet") from None
-    metadata = table.schema.metadata or {}
-    if PARQUET_META_KEY not in metadata:
-        raise RecordingError(
-            f"Parquet schema metadata has no {PARQUET_META_KEY.decode()!r} entry",
-            source=source, key="meta", rule="missing-meta",
-        )
-    meta_text = _decode_utf8(metadata[PARQUET_META_KEY], source, "embedded metadata")
-    return table.replace_schema_metadata(None), _parse_meta(meta_text, source)
+    return columns.finish(), meta
 
 
 # --------------------------------------------------------------------------------------
@@ -432,15 +475,10 @@ def read_recording(path: str | Path) -> Recording:
                 source=source, key=str(meta_path), rule="missing-meta-file",
             )
         meta = _parse_meta(_decode_utf8(meta_path.read_bytes(), str(meta_path), "metadata"), str(meta_path))
-        table = _read_csv_table(path)
+        columns = _csv_columns(path)
     else:
-        table, meta = _read_parquet(path)
-    n = table.num_rows
-    frame = _frame_from_table(table, source)
-    del table
-    if n != len(frame):  # pragma: no cover - defensive
-        raise RuntimeError("row count changed while converting")
-    return Recording(frame, meta, name=path.stem).validate(source)
+        columns, meta = _read_parquet(path)
+    return Recording(_frame(columns, source), meta, name=path.stem).validate(source)
 
 
 def _check_input_file(path: Path) -> None:
