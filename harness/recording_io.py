@@ -273,13 +273,23 @@ class _Columns:
             for a in self.arrays:
                 a.resize(self.capacity, refcheck=False)
         self._check_nulls(batch)
-        for j, name in enumerate(self.names):
-            column = batch.column(j)
-            if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type)):
-                raise RecordingError(f"values must be numbers, the column holds {column.type}", source=self.source,
-                                     key=f"column {name!r}", rule="non-numeric")
-            self.arrays[j][self.n:self.n + k] = column.to_numpy(zero_copy_only=False)
+        for j in range(len(self.names)):
+            self.put(j, self.n, batch.column(j), blank_rows_checked=True)
         self.n += k
+
+    def put(self, j: int, offset: int, column: pa.Array, blank_rows_checked: bool = False) -> int:
+        """Copy ``column`` into column ``j`` from row ``offset``; the next offset. Empty values are
+        refused unless the caller has already told blank lines from empty fields."""
+        if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type)):
+            raise RecordingError(f"values must be numbers, the column holds {column.type}", source=self.source,
+                                 key=f"column {self.names[j]!r}", rule="non-numeric")
+        if column.null_count and not blank_rows_checked:
+            row = offset + pc.index(pc.is_null(column), True).as_py()
+            raise RecordingError(f"empty value at {row_label(row)}", source=self.source,
+                                 key=f"column {self.names[j]!r}", rule="non-numeric")
+        k = len(column)
+        self.arrays[j][offset:offset + k] = column.to_numpy(zero_copy_only=False)
+        return offset + k
 
     def _check_nulls(self, batch: pa.RecordBatch) -> None:
         if not any(c.null_count for c in batch.columns):
@@ -379,8 +389,11 @@ def _read_parquet(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         names = list(pf.schema_arrow.names)
         canonical_names(names, source)
         columns = _Columns(names, pf.metadata.num_rows, source)
-        for batch in pf.iter_batches(batch_size=1 << 16):
-            columns.add(batch)
+        for j in range(len(names)):  # column by column: a row group is never decoded whole
+            offset = 0
+            for batch in pf.iter_batches(batch_size=1 << 16, columns=[names[j]], use_threads=False):
+                offset = columns.put(j, offset, batch.column(0))
+        columns.n = pf.metadata.num_rows
     except (pa.ArrowException, OSError) as exc:
         raise RecordingError(f"not a readable Parquet file ({' '.join(str(exc).split())[:200]})", source=source,
                              key="file", rule="bad-parquet") from None
