@@ -1,4 +1,4 @@
-"""The ``sidbench gallery`` and ``sidbench diagnosis-sweep`` subcommands."""
+"""The ``sidbench gallery``, ``sidbench diagnosis-sweep`` and ``sidbench outside-sweep`` subcommands."""
 from __future__ import annotations
 
 import argparse
@@ -16,6 +16,14 @@ def cmd_gallery(args: argparse.Namespace) -> int:
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from harness.diagnosis.sweep import markdown, sweep
+    rows = sweep(args.out, args.case, args.workers)
+    print(markdown(rows))
+    print(f"wrote {args.out}/sweep.md and sweep.json")
+    return 0
+
+
+def cmd_outside_sweep(args: argparse.Namespace) -> int:
+    from harness.diagnosis.outside import markdown, sweep
     rows = sweep(args.out, args.case, args.workers)
     print(markdown(rows))
     print(f"wrote {args.out}/sweep.md and sweep.json")

@@ -1,0 +1,559 @@
+"""The outside sweep: the discrepancy diagnosis scored on recordings made the way a flight-test
+team's data arrive, at flight conditions and on an aircraft the project did not tune it on.
+
+Each case flies one aircraft (the F-16, or the JSBSim package's ``c172x`` given by the path of
+its XML; the 737 in a self-check) at a condition given by value, with at most one concealed
+effect (``models.hidden``), and post-processes the flight as instruments would record it:
+
+- **Actuators.** Each commanded surface passes through a second-order actuator
+  (ω = 40 rad/s, ζ = 0.7, zero-order-hold exact on the simulation frames) *before* it is
+  flown, so the aircraft flies the actuator output and the recording holds the measured
+  actuator position (plus 0.05° white noise), not the command. (At the closed-loop
+  conditions the project's pitch-rate feedback adds to the actuator output.)
+- **Gyros measure inertial rates**: p, q, r = JSBSim's Earth-relative body rates plus the
+  Earth's rotation in body axes, C_bn·ω_e (from the true attitude and the trim latitude).
+- **Air data**: white plus first-order Gauss-Markov noise on α and β (0.1° each, τ = 1 s);
+  the ``white`` preset's levels on every other channel; the angular accelerations dropped.
+- **Values rounded to 8 significant digits**, as a telemetry export prints them; no altitude
+  channel in some cases, no thrust channel in others; metadata a team would write (geometry,
+  mass, a trim block of α, V and h from the first second), no simulation details.
+
+Maneuvers: pitch-only (stabilator 3-2-1-1; validation 2-1-1-2), lateral-only (aileron doublet
+and rudder 2-1-1; validation rudder doublet and aileron 2-1-1) and three-axis (both), with
+null recordings of each kind on each aircraft, and noise-free self-checks (a clean recording
+of the model itself: no noise, no actuator, no rounding) of the F-16, the 737 and the c172x.
+
+Scoring (per case, and totals): (a) the right effect *and parameter* first; (b) its size
+within 2 standard errors or 25 %; (c) false findings: every finding other than the true one
+(on a null, every finding but ``none``); (d) the validation RMS of the affected output drops
+by 30 % or more (turbulence and structural modes excepted).
+"""
+from __future__ import annotations
+
+import json
+import math
+import traceback
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import signal
+
+from harness.atomic import write_text_atomic
+from harness.diagnosis.gallery import StructuralMode, conceal
+from harness.noise import ChannelNoise, NoiseModel, apply_noise
+from harness.noise_presets import WHITE_LEVELS
+from harness.recording_io import write_recording
+from maneuvers.combine import Sequence
+from maneuvers.fly import FlightSpec, fly_maneuver
+from maneuvers.multistep import multistep
+from maneuvers.recording import Recording
+from models.aircraft import Aircraft
+from models.atmosphere import Turbulence
+from models.flight import Loop
+from models.hidden import HiddenEffect as H
+
+DEG = math.pi / 180.0
+EARTH_RATE_RPS = 7.292115e-5  # WGS-84, as JSBSim
+BAR_DROP = 0.30
+DURATION_S = 30.0
+SIGNIFICANT_DIGITS = 8
+
+
+def c172x_path() -> str:
+    """The JSBSim package's c172x, by the path of its XML (an aircraft the project has no
+    model of its own for)."""
+    import jsbsim
+    return str(Path(jsbsim.get_default_root_dir()) / "aircraft" / "c172x" / "c172x.xml")
+
+
+# ---------------------------------------------------------------------------------------------
+# The recording pipeline
+
+
+@dataclass(frozen=True)
+class Actuated:
+    """An input passed through a second-order actuator, ω²/(s² + 2ζωs + ω²), per surface.
+
+    Implements :class:`maneuvers.base.InputSignal`: :meth:`deflections` filters the inner
+    input's commands on the (uniform) time grid it is given, the frame grid of the flight
+    loop, with the zero-order-hold discretisation (exact for the piecewise-constant
+    multi-step commands)."""
+
+    inner: object
+    omega_rps: float = 40.0
+    zeta: float = 0.7
+
+    @property
+    def name(self) -> str:
+        return f"{self.inner.name}+actuator"
+
+    @property
+    def surfaces(self) -> tuple[str, ...]:
+        return self.inner.surfaces
+
+    @property
+    def start_s(self) -> float:
+        return self.inner.start_s
+
+    @property
+    def active_duration_s(self) -> float:
+        return self.inner.active_duration_s
+
+    @property
+    def duration_s(self) -> float:
+        return self.inner.duration_s
+
+    def describe(self) -> str:
+        return (f"{self.inner.describe()}, through second-order actuators "
+                f"(omega {self.omega_rps:g} rad/s, zeta {self.zeta:g})")
+
+    def deflections(self, t) -> dict[str, np.ndarray]:
+        t = np.asarray(t, dtype=float)
+        cmd = self.inner.deflections(t)
+        if t.size < 2:
+            return cmd
+        dt = float(t[1] - t[0])
+        if not np.allclose(np.diff(t), dt, rtol=1e-6, atol=1e-12):
+            raise ValueError("the actuator filters a uniform time grid only")
+        w, z = self.omega_rps, self.zeta
+        num, den, _ = signal.cont2discrete(([w * w], [1.0, 2.0 * z * w, w * w]), dt, method="zoh")
+        b, a = np.ravel(num), np.ravel(den)
+        return {s: signal.lfilter(b, a, np.asarray(u, dtype=float)) for s, u in cmd.items()}
+
+
+def euler_to_body(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """C_bn (NED to body, 3-2-1 Euler angles) per sample: shape (n, 3, 3)."""
+    cf, sf, ct, st, cp, sp = np.cos(phi), np.sin(phi), np.cos(theta), np.sin(theta), np.cos(psi), np.sin(psi)
+    return np.stack([
+        np.stack([ct * cp, ct * sp, -st], -1),
+        np.stack([sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct], -1),
+        np.stack([cf * st * cp + sf * sp, cf * st * sp - sf * cp, cf * ct], -1)], -2)
+
+
+def earth_rate_body(phi, theta, psi, latitude_rad: float = 0.0) -> np.ndarray:
+    """The Earth's rotation in body axes, (n, 3) rad/s: C_bn·[Ω cos λ, 0, −Ω sin λ]."""
+    w_n = np.array([EARTH_RATE_RPS * math.cos(latitude_rad), 0.0, -EARTH_RATE_RPS * math.sin(latitude_rad)])
+    return euler_to_body(np.asarray(phi), np.asarray(theta), np.asarray(psi)) @ w_n
+
+
+def inertial_gyros(data: pd.DataFrame, latitude_rad: float = 0.0) -> pd.DataFrame:
+    """A copy with p, q, r turned from Earth-relative into inertial body rates (what a gyro
+    measures). The project's trim flies at latitude 0 (``models.trim``); the transport rate
+    of flight over the curved Earth (V/R ≈ 2e-5 rad/s) is left out."""
+    out = data.copy()
+    w = earth_rate_body(data["phi_rad"].to_numpy(), data["theta_rad"].to_numpy(), data["psi_rad"].to_numpy(),
+                        latitude_rad)
+    for i, c in enumerate(("p_rps", "q_rps", "r_rps")):
+        out[c] = data[c].to_numpy() + w[:, i]
+    return out
+
+
+def round_significant(x: np.ndarray, digits: int = SIGNIFICANT_DIGITS) -> np.ndarray:
+    """``x`` rounded to ``digits`` significant decimal digits (as a ``%.8g`` export prints)."""
+    fmt = f"{{:.{digits}g}}".format
+    return np.array([float(fmt(v)) for v in np.asarray(x, dtype=float).tolist()])
+
+
+def flight_test_noise() -> NoiseModel:
+    """White noise at the ``white`` preset's levels on every channel, and on α and β a
+    first-order Gauss-Markov process besides (0.1°, τ = 1 s): vane and air-data errors
+    that wander. No deliberate biases (a sensor bias is a concealed effect of its own)."""
+    channels = {k: ChannelNoise(white_std=v) for k, v in WHITE_LEVELS.items()}
+    for k in ("alpha", "beta"):
+        channels[k] = ChannelNoise(white_std=WHITE_LEVELS[k], colored_std=0.1 * DEG, colored_tau_s=1.0)
+    return NoiseModel.build("flight-test", channels, source="sidbench outside sweep: white preset levels, "
+                                                             "Gauss-Markov 0.1 deg (tau 1 s) on alpha and beta",
+                            drop=("pdot", "qdot", "rdot"))
+
+
+def _team_meta(meta: dict, data: pd.DataFrame, aircraft_label: str, maneuver: str) -> dict:
+    """What a flight-test team would send: format, aircraft, geometry, mass, sensors, thrust
+    line, a trim block from the first second of data; nothing about the simulation."""
+    first = data["t_s"] <= data["t_s"].iloc[0] + 1.0
+    trim = {"alpha_rad": float(data.loc[first, "alpha_rad"].mean()), "V_fps": float(data.loc[first, "V_fps"].mean())}
+    if "h_ft" in data:
+        trim["h_ft"] = float(data.loc[first, "h_ft"].mean())
+    return {"format": meta["format"], "aircraft": aircraft_label, "geometry": meta["geometry"], "mass": meta["mass"],
+            "sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]}, "thrust_offset_ft": meta.get("thrust_offset_ft", 0.0),
+            "source": "flight-test-like recording (sidbench outside sweep): measured surfaces, inertial gyros, "
+                      "8 significant digits", "maneuver": maneuver, "trim": trim}
+
+
+def postprocess(rec: Recording, *, noise: bool = True, seed: int = 1, drop: tuple[str, ...] = (),
+                mode: StructuralMode | None = None, aircraft_label: str = "") -> tuple[Recording, dict]:
+    """A flown recording as a flight-test team's data arrive; ``(recording, answer)``.
+
+    ``noise=False`` gives the clean self-check recording (Earth-relative rates, no noise, no
+    rounding: the model's own flight, concealed). ``drop`` removes quantities (``h``,
+    ``thrust``)."""
+    if mode is not None:
+        rec = mode.add_to(rec)
+    if noise:
+        rec = Recording(data=inertial_gyros(rec.data), meta=rec.meta, name=rec.name)
+        rec = apply_noise(rec, flight_test_noise(), seed)
+    rec, answer = conceal(rec)
+    data = rec.data.drop(columns=[c for c in rec.data.columns
+                                  if c.split("_")[0] in set(drop) | {"pdot", "qdot", "rdot"}])
+    if noise:
+        data = pd.DataFrame({c: round_significant(data[c].to_numpy()) for c in data.columns})
+    meta = _team_meta(rec.meta, data, aircraft_label or rec.meta.get("aircraft", ""), rec.meta.get("maneuver", ""))
+    return Recording(data=data, meta=meta, name=rec.name).validate("outside recording"), answer
+
+
+# ---------------------------------------------------------------------------------------------
+# Conditions, maneuvers and cases
+
+
+@dataclass(frozen=True)
+class Condition:
+    """Where a case flies: aircraft, condition by value, loop, input amplitudes (deg)."""
+
+    key: str
+    aircraft: str          # 'f16', '737' or 'c172x'
+    condition: str         # 'h=...,V=...'
+    de_deg: float
+    da_deg: float
+    dr_deg: float
+    pitch_rate_gain: float = 0.0   # > 0: the project's pitch-rate loop (the bare airframe diverges here)
+    note: str = ""
+
+    @property
+    def model(self) -> str:
+        return c172x_path() if self.aircraft == "c172x" else self.aircraft
+
+    @property
+    def loop(self) -> Loop:
+        return Loop("closed", self.pitch_rate_gain) if self.pitch_rate_gain else Loop()
+
+
+CONDITIONS = {c.key: c for c in (
+    Condition("S", "f16", "h=10000,V=420", 2.0, 3.0, 3.0, note="the seed's: 10,000 ft, 420 ft/s, alpha 5.3 deg"),
+    Condition("L", "f16", "h=5000,V=330", 2.0, 3.0, 3.0, note="5,000 ft, 330 ft/s, alpha 7.9 deg"),
+    Condition("F", "f16", "h=10000,V=427.4", 1.5, 3.0, 3.0,
+              note="10,000 ft, 427.4 ft/s, alpha 5.03 deg: at the leading-edge-flap switch (5.00 deg)"),
+    Condition("M", "f16", "h=15000,V=550", 1.0, 3.0, 3.0, 0.3,
+              note="15,000 ft, 550 ft/s, alpha 3.1 deg; pitch-rate loop K = 0.3 s (open loop it dives)"),
+    Condition("H", "f16", "h=25000,V=700", 1.0, 2.0, 2.0, 0.3,
+              note="25,000 ft, 700 ft/s, alpha 2.5 deg; pitch-rate loop K = 0.3 s (open loop it diverges)"),
+    Condition("C1", "c172x", "h=4000,V=180", 2.0, 5.0, 5.0, note="c172x, 4,000 ft, 180 ft/s, alpha 0.8 deg"),
+    Condition("C2", "c172x", "h=8000,V=200", 2.0, 5.0, 5.0, note="c172x, 8,000 ft, 200 ft/s, alpha 0.6 deg"),
+    Condition("B", "737", "h=30000,V=750", 1.0, 3.0, 3.0, note="737 cruise, 30,000 ft, 750 ft/s"),
+)}
+
+KINDS = ("pitch", "lateral", "three_axis")
+
+
+def maneuvers(kind: str, cond: Condition) -> tuple[Sequence, Sequence]:
+    """Identification and (different) validation inputs of a kind at a condition."""
+    a_e, a_a, a_r = cond.de_deg, cond.da_deg, cond.dr_deg
+    pitch_id = (multistep("3-2-1-1", "de", a_e, 0.5),)
+    pitch_va = (multistep("2-1-1-2", "de", 0.75 * a_e, 0.7),)
+    lat_id = (multistep("doublet", "da", a_a, 1.0), multistep("2-1-1", "dr", a_r, 1.0))
+    lat_va = (multistep("doublet", "dr", a_r, 1.0), multistep("2-1-1", "da", a_a, 0.7))
+    ident, valid = {"pitch": (pitch_id, pitch_va), "lateral": (lat_id, lat_va),
+                    "three_axis": (pitch_id + lat_id, pitch_va + lat_va)}[kind]
+    return (Sequence(ident, gap_s=2.0, name=f"outside_{kind}_identification"),
+            Sequence(valid, gap_s=2.0, name=f"outside_{kind}_validation"))
+
+
+@dataclass(frozen=True)
+class OutsideCase:
+    """One recording pair of the outside sweep and what the diagnosis must say of it."""
+
+    name: str
+    where: str                  # a CONDITIONS key
+    kind: str                   # pitch, lateral, three_axis
+    effects: tuple = ()
+    expect: str = "none"
+    parameter: str = ""
+    truth: float = 0.0
+    channel: str = ""           # the affected output (condition d)
+    seed: int = 1
+    turbulence: Turbulence | None = None
+    mode: StructuralMode | None = None
+    drop: tuple[str, ...] = ()  # quantities the team did not record (h, thrust)
+    clean: bool = False         # the noise-free self-check
+    self_check: bool = False
+
+    @property
+    def condition(self) -> Condition:
+        return CONDITIONS[self.where]
+
+
+def _drops(i: int) -> tuple[str, ...]:
+    """Every third case lacks the altitude channel, every third (shifted) the thrust."""
+    return {0: (), 1: ("h",), 2: ("thrust",)}[i % 3]
+
+
+def cases() -> tuple[OutsideCase, ...]:
+    """~75 cases: every effect id of effects.md over five F-16 conditions and two c172x
+    conditions, the three maneuver kinds, nulls of each kind on each aircraft, self-checks."""
+    spec = [
+        # where, kind, effect, expect, parameter, truth, channel
+        # --- F-16, pitch-only
+        ("S", "pitch", H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q"),
+        ("L", "pitch", H("unsteady_alphadot", -3.0), "Cm_alphadot", -3.0, "q"),
+        ("M", "pitch", H("coefficient_error", -0.1, regressor="alpha"), "Cm_alpha", -0.1, "q"),
+        ("H", "pitch", H("coefficient_error", -0.5, coefficient="CZ", regressor="alpha"), "CZ_alpha", -0.5, "az"),
+        ("F", "pitch", H("nonlinear_alpha", 1.0), "Cm_alpha2", 1.0, "q"),
+        ("S", "pitch", H("control_delay", 0.08, surface="de"), "tau_de", 0.08, "q"),
+        ("L", "pitch", H("cg_offset", 0.5), "dx_moment_reference", 0.5, "q"),
+        ("F", "pitch", H("sensor_bias", 1.5 * DEG, channel="alpha"), "bias_alpha", 1.5 * DEG, "alpha"),
+        ("M", "pitch", H("sensor_bias", 0.5 * DEG, channel="q"), "bias_q", 0.5 * DEG, "q"),
+        ("H", "pitch", H("sensor_scale", 0.08, channel="alpha"), "scale_alpha", 0.08, "alpha"),
+        ("S", "pitch", H("sensor_offset", 10.0, position_ft=(10.0, 0.0, 0.0)), "x_accelerometer", 10.0, "az"),
+        ("L", "pitch", H("sensor_time_skew", 0.04, channel="q"), "skew_q", 0.04, "q"),
+        ("F", "pitch", H("flight_condition_drift", 0.02), "Cm_dV", 0.02, "q"),
+        ("H", "pitch", H("sensor_bias", 0.04, channel="az"), "bias_az", 0.04, "az"),
+        # --- F-16, lateral-only
+        ("S", "lateral", H("coefficient_error", -0.02, coefficient="Cl", regressor="beta"), "Cl_beta", -0.02, "p"),
+        ("L", "lateral", H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r"),
+        ("H", "lateral", H("coefficient_error", -0.3, coefficient="Cn", regressor="rhat"), "Cn_rhat", -0.3, "r"),
+        ("L", "lateral", H("coefficient_error", -0.1, coefficient="Cl", regressor="phat"), "Cl_phat", -0.1, "p"),
+        ("F", "lateral", H("control_delay", 0.06, surface="da"), "tau_da", 0.06, "p"),
+        ("S", "lateral", H("control_delay", 0.08, surface="dr"), "tau_dr", 0.08, "r"),
+        ("M", "lateral", H("cross_coupling", -0.2, coefficient="Cl", regressor="beta_abs"), "Cl_beta_abs", -0.2, "p"),
+        ("L", "lateral", H("sensor_bias", 1.0 * DEG, channel="beta"), "bias_beta", 1.0 * DEG, "beta"),
+        ("F", "lateral", H("sensor_bias", 0.5 * DEG, channel="r"), "bias_r", 0.5 * DEG, "r"),
+        ("S", "lateral", H("sensor_scale", 0.15, channel="beta"), "scale_beta", 0.15, "beta"),
+        ("M", "lateral", H("sensor_offset", 0.0, position_ft=(0.0, 6.0, 0.0)), "offset_y", 6.0, "ay"),
+        ("H", "lateral", H("sensor_time_skew", 0.04, channel="p"), "skew_p", 0.04, "p"),
+        # --- F-16, three-axis
+        ("S", "three_axis", H("cross_coupling", -2.0, coefficient="Cl"), "Cl_alpha_beta", -2.0, "p"),
+        ("F", "three_axis", H("cross_coupling", 2.0, coefficient="Cn"), "Cn_alpha_beta", 2.0, "r"),
+        ("L", "three_axis", H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q"),
+        ("H", "three_axis", H("unsteady_alphadot", -3.0), "Cm_alphadot", -3.0, "q"),
+        ("M", "three_axis", H("cg_offset", 1.0), "dx_moment_reference", 1.0, "q"),
+        ("F", "three_axis", H("control_delay", 0.06, surface="de"), "tau_de", 0.06, "q"),
+        ("S", "three_axis", H("sensor_bias", 0.75 * DEG, channel="alpha"), "bias_alpha", 0.75 * DEG, "alpha"),
+        ("L", "three_axis", H("sensor_offset", 5.0, position_ft=(5.0, 0.0, 0.0)), "x_accelerometer", 5.0, "az"),
+        ("H", "three_axis", H("sensor_time_skew", 0.04, channel="az"), "skew_az", 0.04, "az"),
+        ("F", "three_axis", H("nonlinear_alpha", -5.0, coefficient="CZ"), "CZ_alpha2", -5.0, "az"),
+        ("L", "three_axis", H("sensor_bias", 0.04, channel="az"), "bias_az", 0.04, "az"),
+        ("M", "three_axis", H("sensor_scale", 0.06, channel="V"), "scale_V", 0.06, "V"),
+        ("S", "three_axis", H("sensor_bias", 10.0, channel="V"), "bias_V", 10.0, "V"),
+        ("M", "three_axis", H("flight_condition_drift", 0.02), "Cm_dV", 0.02, "q"),
+        # --- c172x (the package's, by path)
+        ("C1", "pitch", H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q"),
+        ("C2", "pitch", H("unsteady_alphadot", -3.0), "Cm_alphadot", -3.0, "q"),
+        ("C2", "pitch", H("control_delay", 0.08, surface="de"), "tau_de", 0.08, "q"),
+        ("C1", "pitch", H("sensor_bias", 1.0 * DEG, channel="alpha"), "bias_alpha", 1.0 * DEG, "alpha"),
+        ("C2", "pitch", H("nonlinear_alpha", 1.0), "Cm_alpha2", 1.0, "q"),
+        ("C1", "lateral", H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r"),
+        ("C2", "lateral", H("control_delay", 0.08, surface="dr"), "tau_dr", 0.08, "r"),
+        ("C1", "lateral", H("sensor_bias", 1.0 * DEG, channel="beta"), "bias_beta", 1.0 * DEG, "beta"),
+        ("C2", "lateral", H("control_delay", 0.06, surface="da"), "tau_da", 0.06, "p"),
+        ("C2", "three_axis", H("cg_offset", 0.25), "dx_moment_reference", 0.25, "q"),
+        ("C1", "three_axis", H("sensor_offset", 5.0, position_ft=(5.0, 0.0, 0.0)), "x_accelerometer", 5.0, "az"),
+        ("C1", "three_axis", H("coefficient_error", -0.5, coefficient="CZ", regressor="alpha"), "CZ_alpha", -0.5,
+         "az"),
+        ("C2", "three_axis", H("cross_coupling", -2.0, coefficient="Cl"), "Cl_alpha_beta", -2.0, "p"),
+        ("C1", "three_axis", H("sensor_scale", 0.1, channel="alpha"), "scale_alpha", 0.1, "alpha"),
+        ("C2", "three_axis", H("sensor_time_skew", 0.04, channel="q"), "skew_q", 0.04, "q"),
+        ("C1", "three_axis", H("flight_condition_drift", 0.02), "Cm_dV", 0.02, "q"),
+    ]
+    out: list[OutsideCase] = []
+    for where, kind, e, param, truth, ch in spec:
+        label = f"{truth:g}" if abs(truth) >= 0.01 or truth == 0 else f"{truth / DEG:g}deg"
+        out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{label}", where, kind, (e,), e.effect, param,
+                               truth, ch))
+    mode, small_mode = StructuralMode(8.0, 0.02, 0.5, 3.0), StructuralMode(7.0, 0.03, 0.3, 2.0)
+    for where, kind, m in (("S", "pitch", mode), ("M", "three_axis", mode), ("C2", "pitch", small_mode)):
+        out.append(OutsideCase(f"{where}_{kind}_structural_mode_{m.frequency_hz:g}Hz", where, kind, (),
+                               "structural_mode", "mode_frequency_hz", m.frequency_hz, "", mode=m))
+    for where, kind, sev in (("M", "pitch", 3), ("H", "lateral", 3), ("S", "three_axis", 4), ("C2", "three_axis", 3)):
+        out.append(OutsideCase(f"{where}_{kind}_turbulence_sev{sev}", where, kind, (), "turbulence", "sigma_gust_fps",
+                               float("nan"), "", turbulence=Turbulence("dryden", sev, 30.0)))
+    nulls = [("S", "pitch", 1), ("H", "pitch", 2), ("F", "pitch", 3), ("L", "lateral", 4), ("M", "lateral", 5),
+             ("S", "three_axis", 6), ("L", "three_axis", 7), ("M", "three_axis", 8), ("H", "three_axis", 9),
+             ("F", "three_axis", 10), ("C1", "pitch", 11), ("C2", "lateral", 12), ("C1", "three_axis", 13),
+             ("C2", "three_axis", 14)]
+    for where, kind, seed in nulls:
+        out.append(OutsideCase(f"{where}_{kind}_none_s{seed}", where, kind, seed=seed))
+    out = [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
+    for where in ("S", "B", "C1"):
+        out.append(OutsideCase(f"selfcheck_{CONDITIONS[where].aircraft}_{where}", where, "three_axis", clean=True,
+                               self_check=True))
+    return tuple(out)
+
+
+# ---------------------------------------------------------------------------------------------
+# Making, diagnosing and scoring a case
+
+
+def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
+    """Fly and post-process one case's identification and validation recordings; write them
+    and ``<case>.answer.json`` into ``out_dir``."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    cond = c.condition
+    label = {"f16": "F-16", "737": "Boeing 737", "c172x": "Cessna 172 (JSBSim c172x)"}[cond.aircraft]
+    paths, answers = {}, {}
+    for i, (role, inp) in enumerate(zip(("identification", "validation"), maneuvers(c.kind, cond))):
+        flown = inp if c.clean else Actuated(inp)
+        spec = FlightSpec(input=flown, aircraft=Aircraft(cond.model, hidden=c.effects), condition=cond.condition,
+                          duration_s=max(DURATION_S, inp.duration_s), loop=cond.loop)
+        if c.turbulence is not None:
+            spec = replace(spec, turbulence=c.turbulence, turbulence_seed=100 * c.seed + i)
+        rec, answer = postprocess(fly_maneuver(spec), noise=not c.clean, seed=1000 * c.seed + i, drop=c.drop,
+                                  mode=c.mode, aircraft_label=label)
+        paths[role] = write_recording(rec, out_dir / f"{c.name}-{role}.csv")
+        answers[role] = answer["hidden_effects"]
+    write_text_atomic(out_dir / f"{c.name}.answer.json", json.dumps(
+        {"case": c.name, "aircraft": cond.aircraft, "condition": cond.condition, "loop": cond.loop.describe(),
+         "kind": c.kind, "expect": c.expect, "parameter": c.parameter,
+         "truth": c.truth if math.isfinite(c.truth) else None, "hidden_effects": answers["identification"],
+         "turbulence": None if c.turbulence is None else c.turbulence.describe(),
+         "structural_mode": None if c.mode is None else asdict(c.mode), "dropped": list(c.drop),
+         "recording": "clean (self-check)" if c.clean else "flight-test-like"}, indent=1))
+    return paths
+
+
+def _key(f: dict) -> tuple[str, str]:
+    return f.get("effect"), f.get("parameter")
+
+
+def score(c: OutsideCase, result: dict) -> dict:
+    """Criteria a-d and the false findings of one case from its findings.json content."""
+    findings = result["findings"]
+    first = findings[0]
+    row = {"case": c.name, "aircraft": c.condition.aircraft, "where": c.where, "condition": c.condition.condition,
+           "kind": c.kind, "expect": c.expect, "parameter": c.parameter,
+           "truth": c.truth if math.isfinite(c.truth) else None, "dropped": list(c.drop), "self_check": c.self_check,
+           "first": {k: first.get(k) for k in ("effect", "parameter", "estimate", "std_error")},
+           "findings": [{k: f.get(k) for k in ("effect", "parameter", "estimate", "std_error")} for f in findings]}
+    if c.expect == "none":
+        false = [f for f in findings if f["effect"] != "none"]
+        row.update(a=first["effect"] == "none", b=None, d=None)
+    else:
+        false = [f for f in findings if _key(f) != (c.expect, c.parameter)]
+        row["a"] = _key(first) == (c.expect, c.parameter)
+        estimate = first["evidence"].get("change", first["estimate"]) if c.expect == "coefficient_error" \
+            else first["estimate"]
+        row["b"] = None if not math.isfinite(c.truth) else bool(row["a"] and (
+            abs(estimate - c.truth) <= 2.0 * first["std_error"] or abs(estimate - c.truth) <= 0.25 * abs(c.truth)))
+        row["d"] = None
+        if c.channel:
+            row["d"] = False
+            if "validation" in first.get("fit_before", {}) and first["effect"] != "none":
+                before = first["fit_before"]["validation"]["outputs"].get(c.channel, {}).get("rms")
+                after = first["fit_after"]["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
+                if before and after is not None:
+                    row["validation_rms"] = [before, after]
+                    row["d"] = bool(row["a"] and 1.0 - after / before >= BAR_DROP)
+    row["false"] = [f"{f['effect']}:{f['parameter']}" for f in false]
+    row["c"] = len(false)
+    return row
+
+
+def run_case(c: OutsideCase, out: Path) -> dict:
+    """Make, diagnose and score one case; its row goes to ``out/results/<case>.json``. A case
+    whose recording or diagnosis fails is scored as failing every criterion, with the error."""
+    from harness.diagnosis.run import diagnose
+    try:
+        paths = write_case(c, out / "recordings")
+        result = diagnose(c.condition.model, paths["identification"], out / "diagnoses" / c.name,
+                          paths["validation"])
+        row = score(c, result) | {"timing_s": result["timing_s"]["total"], "error": None}
+    except Exception as exc:  # noqa: BLE001 - a measurement: the row says what broke
+        row = {"case": c.name, "aircraft": c.condition.aircraft, "where": c.where, "condition": c.condition.condition,
+               "kind": c.kind, "expect": c.expect, "parameter": c.parameter,
+               "truth": c.truth if math.isfinite(c.truth) else None, "dropped": list(c.drop),
+               "self_check": c.self_check, "first": None, "findings": [], "a": False,
+               "b": False if c.expect != "none" and math.isfinite(c.truth) else None, "c": 0, "false": [],
+               "d": False if c.channel else None, "timing_s": None,
+               "error": f"{type(exc).__name__}: {exc}".splitlines()[0][:300],
+               "traceback": traceback.format_exc()[-2000:]}
+    write_text_atomic(out / "results" / f"{c.name}.json", json.dumps(row, indent=1))
+    return row
+
+
+# ---------------------------------------------------------------------------------------------
+# Summary
+
+
+def _share(rows: list[dict], k: str) -> str:
+    scored = [r for r in rows if r[k] is not None]
+    return f"{sum(bool(r[k]) for r in scored)}/{len(scored)}" if scored else "–"
+
+
+def totals(rows: list[dict]) -> dict:
+    """a, b, d as passed/scored; c as the number of false findings and of cases with any."""
+    return {"cases": len(rows), "a": _share(rows, "a"), "b": _share(rows, "b"), "d": _share(rows, "d"),
+            "false_findings": sum(r["c"] for r in rows), "cases_with_false": sum(r["c"] > 0 for r in rows),
+            "errors": sum(bool(r.get("error")) for r in rows)}
+
+
+def groups(rows: list[dict]) -> dict[str, dict[str, dict]]:
+    by = {"aircraft": lambda r: r["aircraft"], "condition": lambda r: f"{r['aircraft']} {r['condition']}",
+          "kind": lambda r: r["kind"], "truth": lambda r: "null" if r["expect"] == "none" else "effect"}
+    out = {}
+    for name, key in by.items():
+        keys = list(dict.fromkeys(key(r) for r in rows))
+        out[name] = {k: totals([r for r in rows if key(r) == k]) for k in keys}
+    return out
+
+
+def _finding(f: dict | None) -> str:
+    if f is None:
+        return "error"
+    if f["effect"] == "none":
+        return "none"
+    return f"{f['effect']}: {f['parameter']} = {f['estimate']:.4g} ± {f['std_error']:.2g}"
+
+
+def markdown(rows: list[dict]) -> str:
+    """The per-case table (a, b, c = false findings, d), the totals and the breakdowns."""
+    mark = {True: "✔", False: "✘", None: "–"}
+    lines = ["| case | aircraft, condition | truth | first finding | a | b | c (false) | d | validation RMS |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        v = r.get("validation_rms")
+        drop = f"{v[0]:.3g} → {v[1]:.3g} ({100 * (v[1] / v[0] - 1):+.0f} %)" if v else "–"
+        truth = "–" if r["truth"] is None else f"{r['truth']:.4g}"
+        first = f"error: {r['error']}" if r.get("error") else _finding(r["first"])
+        false = str(r["c"]) + (f" ({', '.join(r['false'])})" if r["false"] else "")
+        where = f"{r['aircraft']} {r['condition']}" + (f", no {'/'.join(r['dropped'])}" if r["dropped"] else "")
+        lines.append(f"| {r['case']} | {where} | {truth} | {first} | {mark[r['a']]} | {mark[r['b']]} | {false} | "
+                     f"{mark[r['d']]} | {drop} |")
+    t = totals(rows)
+    lines += ["", f"**Totals** ({t['cases']} cases): a {t['a']}, b {t['b']}, d {t['d']}; **false findings "
+                  f"{t['false_findings']}** in {t['cases_with_false']} cases (target 0); errors {t['errors']}.", ""]
+    lines += ["| group | cases | a | b | false findings (cases) | d |", "|---|---|---|---|---|---|"]
+    for name, gs in groups(rows).items():
+        for k, g in gs.items():
+            lines.append(f"| {name}: {k} | {g['cases']} | {g['a']} | {g['b']} | {g['false_findings']} "
+                         f"({g['cases_with_false']}) | {g['d']} |")
+    by_effect: dict[str, int] = {}
+    for r in rows:
+        for f in r["false"]:
+            by_effect[f.split(":")[0]] = by_effect.get(f.split(":")[0], 0) + 1
+    if by_effect:
+        lines += ["", "False findings by effect named: " + ", ".join(
+            f"{k} {v}" for k, v in sorted(by_effect.items(), key=lambda kv: -kv[1])) + "."]
+    return "\n".join(lines) + "\n"
+
+
+def sweep(out: str | Path, names: list[str] | None = None, workers: int = 2) -> list[dict]:
+    """Run the outside sweep (the cases ``names``, default all) into ``out``; finished cases
+    are read back, not run again."""
+    out = Path(out)
+    chosen = [c for c in cases() if names is None or c.name in names]
+    if names is not None and len(chosen) != len(set(names)):
+        known = {c.name for c in cases()}
+        raise ValueError(f"no outside-sweep case {sorted(set(names) - known)}; see harness/diagnosis/outside.py")
+    todo = [c for c in chosen if not (out / "results" / f"{c.name}.json").is_file()]
+    if todo:
+        with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+            for c, row in zip(todo, pool.map(run_case, todo, [out] * len(todo))):
+                print(f"{c.name}: {'error: ' + row['error'] if row.get('error') else 'done'}", flush=True)
+    rows = [json.loads((out / "results" / f"{c.name}.json").read_text()) for c in chosen]
+    write_text_atomic(out / "sweep.json", json.dumps(
+        {"cases": [asdict(c) | {"effects": [e.describe() for e in c.effects]} for c in chosen],
+         "conditions": {k: asdict(v) for k, v in CONDITIONS.items()}, "rows": rows, "totals": totals(rows),
+         "groups": groups(rows)}, indent=1, default=str))
+    write_text_atomic(out / "sweep.md", markdown(rows))
+    return rows

@@ -1,0 +1,175 @@
+"""Recordings the project did not make (issue 12).
+
+1. An independent script, written here with nothing but ``jsbsim``, flies the package's stock
+   F-16 (gear up, trimmed by JSBSim's own trim at 10,000 ft and 427.4 ft/s, FCS disabled,
+   surfaces driven) and writes the canonical CSV with a hand-written meta.json;
+   ``sidbench diagnose --model f16`` must run on it to the end.
+2. The outside sweep's recording pipeline (``harness.diagnosis.outside``): actuators flown,
+   inertial gyros, 8 significant digits.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+G0 = 32.17404855643
+
+
+def independent_f16_recording(path: Path, duration_s: float = 20.0) -> dict:
+    """Fly the stock F-16 with jsbsim alone and write ``path`` (.csv) and its .meta.json.
+
+    Returns the Earth-relative and inertial body rates JSBSim reported, for the gyro check."""
+    import jsbsim
+    jsbsim.FGJSBBase().debug_lvl = 0
+    fdm = jsbsim.FGFDMExec(None)  # the package's own root and aircraft
+    fdm.set_debug_level(0)
+    assert fdm.load_model("f16")
+    fdm.set_dt(1.0 / 100.0)
+    fdm["ic/lat-gc-deg"] = 0.0  # position first, then altitude, then speed
+    fdm["ic/long-gc-deg"] = 0.0
+    fdm["ic/h-sl-ft"] = 10_000.0
+    fdm["ic/vt-fps"] = 427.4
+    fdm["ic/psi-true-deg"] = 0.0
+    fdm["gear/gear-cmd-norm"] = 0.0
+    fdm.run_ic()
+    fdm["gear/gear-pos-norm"] = 0.0
+    fdm.do_trim(1)
+    fdm["propulsion/fuel_freeze"] = 1
+    fdm["simulation/models/FGFCS/enabled"] = 0
+    surf = {"de": "fcs/elevator-pos-rad", "da": "fcs/aileron-pos-rad", "dr": "fcs/rudder-pos-rad"}
+    trim = {s: fdm[p] for s, p in surf.items()}
+    d = math.radians(1.0)
+
+    def command(t: float) -> dict:
+        """Elevator doublet (1 deg, 1 s pulses) at 1 s, aileron doublet (2 deg) at 6 s, rudder
+        doublet (2 deg) at 11 s."""
+        out = {}
+        for s, t0, a in (("de", 1.0, d), ("da", 6.0, 2 * d), ("dr", 11.0, 2 * d)):
+            out[s] = trim[s] + (a if t0 <= t < t0 + 1 else -a if t0 + 1 <= t < t0 + 2 else 0.0)
+        return out
+
+    cols = ["t_s", "V_fps", "alpha_rad", "beta_rad", "p_rps", "q_rps", "r_rps", "phi_rad", "theta_rad", "psi_rad",
+            "ax_g", "ay_g", "az_g", "de_rad", "da_rad", "dr_rad", "qbar_psf", "h_ft", "mach_1"]
+    rows, rel, ine, att = [], [], [], []
+    mass = fdm["inertia/mass-slugs"]
+    n = int(round(duration_s * 50)) + 1
+    for k in range(n):
+        if k:
+            for _ in range(2):  # 100 Hz simulation, 50 Hz recording
+                for s, v in command(fdm.get_sim_time() + 0.01).items():
+                    fdm[surf[s]] = v
+                fdm.run()
+        pi = [fdm[f"velocities/{a}i-rad_sec"] for a in "pqr"]  # a gyro measures inertial rates
+        rel.append([fdm[f"velocities/{a}-rad_sec"] for a in "pqr"])
+        ine.append(pi)
+        att.append([fdm["attitude/phi-rad"], fdm["attitude/theta-rad"], fdm["attitude/psi-rad"]])
+        rows.append([k / 50.0, fdm["velocities/vt-fps"], fdm["aero/alpha-rad"], fdm["aero/beta-rad"], *pi,
+                     fdm["attitude/phi-rad"], fdm["attitude/theta-rad"], fdm["attitude/psi-rad"],
+                     *(fdm[f"forces/fb{a}-total-lbs"] / (mass * G0) for a in "xyz"),
+                     fdm[surf["de"]], fdm[surf["da"]], fdm[surf["dr"]], fdm["aero/qbar-psf"],
+                     fdm["position/h-sl-ft"], fdm["velocities/mach"]])
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        w.writerows([[f"{v:.10g}" for v in r] for r in rows])
+    meta = {
+        "format": "flight-recording/1",
+        "aircraft": "F-16 (JSBSim package model, stock)",
+        "geometry": {"S_ft2": fdm["metrics/Sw-sqft"], "b_ft": fdm["metrics/bw-ft"], "cbar_ft": fdm["metrics/cbarw-ft"]},
+        "mass": {"mass_slug": mass, "Ix_slugft2": fdm["inertia/ixx-slugs_ft2"], "Iy_slugft2": fdm["inertia/iyy-slugs_ft2"],
+                 "Iz_slugft2": fdm["inertia/izz-slugs_ft2"], "Ixz_slugft2": abs(fdm["inertia/ixz-slugs_ft2"])},
+        "sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]},
+        "thrust_offset_ft": 0.0,
+        "source": f"independent script (tests/test_outside.py), jsbsim {jsbsim.__version__}",
+        "maneuver": "elevator doublet 1 deg, aileron doublet 2 deg, rudder doublet 2 deg, 1 s pulses",
+        "trim": {"alpha_rad": rows[0][2], "V_fps": rows[0][1], "h_ft": rows[0][17]},
+    }
+    path.with_suffix(".meta.json").write_text(json.dumps(meta, indent=1))
+    return {"earth_relative": np.array(rel), "inertial": np.array(ine), "attitude": np.array(att),
+            "latitude_rad": math.radians(fdm["position/lat-gc-deg"])}
+
+
+def test_diagnose_runs_on_an_independent_f16_recording(tmp_path):
+    """The stock F-16 trimmed by JSBSim itself at 10,000 ft and 427.4 ft/s (alpha at the
+    leading-edge-flap switch), recorded by a script of its own: the diagnosis runs to the end."""
+    rec = tmp_path / "independent.csv"
+    independent_f16_recording(rec)
+    out = tmp_path / "diag"
+    proc = subprocess.run([sys.executable, "-m", "harness.cli", "diagnose", "--model", "f16", "--recording", str(rec),
+                           "--out", str(out)], capture_output=True, text=True, timeout=300,
+                          cwd=Path(__file__).resolve().parents[1])
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    findings = json.loads((out / "findings.json").read_text())
+    assert findings["findings"], "findings.json lists no finding (not even none)"
+
+
+def test_outside_gyros_add_earth_rate_like_jsbsim(tmp_path):
+    """inertial = Earth-relative + C_bn·ω_earth, as JSBSim's own inertial rates (to 2e-8 rad/s: the
+    latitude, taken at the end, drifts over the flight)."""
+    import pandas as pd
+
+    from harness.diagnosis.outside import EARTH_RATE_RPS, inertial_gyros
+    got = independent_f16_recording(tmp_path / "r.csv", duration_s=4.0)
+    rel, att = got["earth_relative"], got["attitude"]
+    data = pd.DataFrame({"p_rps": rel[:, 0], "q_rps": rel[:, 1], "r_rps": rel[:, 2], "phi_rad": att[:, 0],
+                         "theta_rad": att[:, 1], "psi_rad": att[:, 2]})
+    ine = inertial_gyros(data, got["latitude_rad"])[["p_rps", "q_rps", "r_rps"]].to_numpy()
+    assert np.max(np.abs(ine - got["inertial"])) < 2e-8  # the latitude drifts over the flight
+    assert np.allclose(np.linalg.norm(ine - rel, axis=1), EARTH_RATE_RPS, rtol=1e-9)
+
+
+def test_outside_recording_pipeline(tmp_path):
+    """Actuator flown and recorded, inertial gyros, values to 8 significant digits, channels
+    dropped, the answer out of the recording."""
+    from harness.diagnosis.outside import (CONDITIONS, EARTH_RATE_RPS, Actuated, flight_test_noise, maneuvers,
+                                           postprocess, round_significant)
+    from harness.noise import apply_noise
+    from maneuvers.fly import FlightSpec, fly_maneuver
+    from maneuvers.recording import Recording
+    from models.aircraft import Aircraft
+    from models.hidden import HiddenEffect
+
+    assert round_significant(np.array([math.pi, -1234.56789012, 1e-9 / 3]), 8).tolist() == \
+        [3.1415927, -1234.5679, 3.3333333e-10]
+    ident, _ = maneuvers("pitch", CONDITIONS["S"])
+    act = Actuated(ident)
+    t = np.arange(1201) / 150.0  # the flight loop's frame grid over 8 s
+    cmd, out = ident.deflections(t)["de"], act.deflections(t)["de"]
+    k = np.flatnonzero(np.diff(cmd))[0] + 1       # the first step of the 3-2-1-1
+    step = cmd[k] - cmd[k - 1]
+    # second order, 40 rad/s, zeta 0.7: the exact step response on the frames after the step
+    w, z = 40.0, 0.7
+    wd, tj = w * math.sqrt(1 - z * z), np.arange(1, 40) / 150.0
+    y = 1 - np.exp(-z * w * tj) * (np.cos(wd * tj) + z / math.sqrt(1 - z * z) * np.sin(wd * tj))
+    assert out[k - 1] == pytest.approx(0.0, abs=1e-12) and out[k] == pytest.approx(0.0, abs=1e-12)
+    assert np.allclose(out[k + 1:k + 40] / step, y, atol=1e-9)
+
+    flown = fly_maneuver(FlightSpec(input=act, aircraft=Aircraft("f16", hidden=(HiddenEffect("nonlinear_alpha", 1.0),)),
+                                    condition="h=10000,V=420", duration_s=8.0))
+    ts = flown.data["t_s"].to_numpy()
+    de_rec = flown.data["de_rad"].to_numpy() - flown.meta["trim"]["de_rad"]
+    # the recorded surface is the actuator output (not the command) at the sample times
+    assert np.allclose(de_rec, np.interp(ts, t, out), atol=1e-9)
+    assert np.max(np.abs(de_rec - np.interp(ts, t, cmd))) > 0.3 * abs(step)
+
+    rec, answer = postprocess(flown, seed=3, drop=("h",), aircraft_label="F-16")
+    assert answer["hidden_effects"] == [{"effect": "nonlinear_alpha", "size": 1.0}]
+    assert "simulation" not in rec.meta and "truth" not in rec.meta
+    assert not any(c.startswith(("truth_", "h_", "pdot", "qdot", "rdot")) for c in rec.data.columns)
+    for c in rec.data.columns:
+        x = rec.data[c].to_numpy()
+        assert np.array_equal(x, round_significant(x)), c
+    # inertial gyros: the same noise draws (streams keyed by seed and channel) on Earth-relative
+    # rates differ from the recording by exactly Earth's rate in body axes
+    earth_relative = apply_noise(flown, flight_test_noise(), 3).data
+    rates = ["p_rps", "q_rps", "r_rps"]
+    diff = rec.data[rates].to_numpy() - earth_relative[rates].to_numpy()
+    assert np.allclose(np.linalg.norm(diff, axis=1), EARTH_RATE_RPS, rtol=1e-3)
+    assert isinstance(rec, Recording) and rec.meta["aircraft"] == "F-16"
