@@ -154,6 +154,21 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     sw.set_defaults(func="harness.diagnosis.commands:cmd_sweep")
 
+    so = sub.add_parser("outside-sweep", help="score the diagnosis on flight-test-like recordings at other conditions "
+                                              "and on a second aircraft (c172x)",
+                        description="Fly about eighty recordings the way a flight-test team's data arrive (surfaces "
+                                    "measured after a second-order actuator, inertial gyros, Gauss-Markov noise on "
+                                    "alpha and beta, 8 significant digits, no h or thrust in some): five F-16 "
+                                    "conditions, two c172x conditions, pitch-only, lateral-only and three-axis "
+                                    "maneuvers, every effect id, nulls and noise-free self-checks (F-16, 737, c172x). "
+                                    "Scores a: right effect and parameter first, b: size within 2 s.e. or 25 %%, "
+                                    "c: false findings, d: validation RMS -30 %%. Writes OUT/sweep.md, OUT/sweep.json "
+                                    "and one result per case (a rerun resumes).")
+    so.add_argument("--out", default="out/outside-sweep", help="output folder")
+    so.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
+    so.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    so.set_defaults(func="harness.diagnosis.commands:cmd_outside_sweep")
+
     r = sub.add_parser("report", help="turn campaign output into HTML, Markdown and JSON reports",
                        description="Write report.html (self-contained), report.md and report.json for a campaign "
                                    "output folder; --kind benchmark ranks the methods over one or more folders.")
