@@ -30,8 +30,9 @@ import numpy as np
 from estimators.differentiation import smooth_derivative
 from estimators.equation_error import EquationErrorTime
 from estimators.least_squares import SingularRegressorsError, r_squared
+from estimators.dynamic_models import ManeuverData, ModelProtocol, maneuver_data
 from estimators.output_error_models import (AffineSystem, ModelSpec, OutputErrorData, affine_system,
-                                            flight_constants, model_spec, output_error_data,
+                                            check_equation, flight_constants, model_spec, output_error_data,
                                             parameter_names, response, response_and_sensitivities)
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit, collinearity
@@ -241,6 +242,10 @@ def _bias_start(problem: _Problem, theta: np.ndarray, free: np.ndarray) -> np.nd
     return out
 
 
+def _not_data(source: object):
+    raise ValueError(f"output error takes a Recording or ManeuverData, not {type(source).__name__}")
+
+
 # ---------------------------------------------------------------------------- the estimator
 @dataclass(frozen=True)
 class OutputError:
@@ -248,9 +253,15 @@ class OutputError:
 
     Parameters
     ----------
-    model : ``'short-period'`` or ``'lateral'``; None chooses from the equation passed to
+    model : ``'short-period'`` or ``'lateral'`` (the built-in linear models, exact
+        sensitivities); a :class:`estimators.dynamic_models.Model` of the user's own (any model,
+        :mod:`estimators.output_error_general`: one recording or ManeuverData, or a list of
+        them fitted together); None chooses a built-in model from the equation passed to
         :meth:`fit` (C_Z, C_m, C_L, C_D, C_X → short period; C_Y, C_l, C_n → lateral), or the
-        short period without one.
+        short period without one. An equation with a dependent or a regressor the built-in
+        model does not have is refused (output error fits the model's structure, not the
+        equation's).
+    x0 : user models: ``'estimate'`` each maneuver's initial state, or ``'fixed'``.
     data : perturbation references, and the options of the equation-error starting fit.
     max_iterations : Gauss-Newton iterations (each followed by an update of R).
     start : starting values by name; derivatives not given come from equation error (ordinary
@@ -259,18 +270,34 @@ class OutputError:
     hold : how inputs behave between samples in the simulation, ``'zoh'`` or ``'foh'``.
     """
 
-    model: str | None = None
+    model: object = None
     data: DataOptions = field(default_factory=DataOptions)
     max_iterations: int = 50
     start: Mapping[str, float] | None = None
     hold: str = "zoh"
     method: str = "oe"
+    x0: str = "estimate"
 
     def __post_init__(self) -> None:
         if self.hold not in HOLDS:
             raise ValueError(f"hold must be one of {HOLDS}, not {self.hold!r}")
         if self.max_iterations < 1:
             raise ValueError("max_iterations must be at least 1")
+        if self.model is not None and not isinstance(self.model, str) and not isinstance(self.model, ModelProtocol):
+            raise ValueError(f"model must be 'short-period', 'lateral' or a Model, not {type(self.model).__name__}")
+
+    def _fit_model(self, source, equation: Equation | None) -> ModelFit:
+        """A user's model (:mod:`estimators.output_error_general`), one or several maneuvers."""
+        from estimators.output_error_general import fit_model
+        model = self.model
+        if equation is not None and equation.regressors:
+            raise ValueError(f"output error fits model {model.name!r} as it is written; it takes no equation "
+                             f"(got {equation.describe()}): leave out the regressors")
+        sources = list(source) if isinstance(source, (list, tuple)) else [source]
+        datasets = [s if isinstance(s, ManeuverData) else maneuver_data(s, model) if isinstance(s, Recording)
+                    else _not_data(s) for s in sources]
+        return fit_model(model, datasets, start=self.start, x0=self.x0, hold=self.hold,
+                         max_iterations=self.max_iterations, method=self.method)
 
     def fit(self, source: Recording | OutputErrorData, equation: Equation | None = None) -> ModelFit:
         """Estimate every parameter of the model (the equation only chooses the model).
@@ -300,13 +327,20 @@ class OutputError:
         DivergenceError
             The model response overflows, or no step reduces the cost.
         """
+        if self.model is not None and not isinstance(self.model, str):
+            return self._fit_model(source, equation)
+        if isinstance(source, (list, tuple)):
+            raise ValueError("several maneuvers are fitted with a Model (estimators.dynamic_models); the built-in "
+                             "models take one recording")
         if isinstance(source, OutputErrorData):
             name = self.model or source.model
             if name != source.model:
                 raise ValueError(f"OutputError(model={self.model!r}) given {source.model!r} data")
+            check_equation(model_spec(name), equation if equation is not None and equation.regressors else None)
             data = source
         else:
             name = model_spec(self.model, equation).name
+            check_equation(model_spec(name), equation)
             data = output_error_data(source, name, self.data)
         spec = data.spec
         for i, u in enumerate(spec.inputs):

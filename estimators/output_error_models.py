@@ -26,6 +26,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from estimators.dynamic_models import Parameter
 from estimators.regressors import DataOptions, Equation, regression_data
 from estimators.state_space import (LATERAL_DERIVATIVES, discretize, discretize_derivatives,
                                     lateral_matrices, propagate, scan, short_period_dimensional,
@@ -100,6 +101,43 @@ class ModelSpec:
         """Index in ``outputs`` of each state (each state is measured directly)."""
         return tuple(self.outputs.index(s) for s in self.states)
 
+    # -- the model specification of :mod:`estimators.dynamic_models` ------------------------
+    @property
+    def parameters(self) -> tuple[Parameter, ...]:
+        """Every parameter (derivatives, then biases), starting at 0 (output error starts the
+        built-in models from equation error, :class:`estimators.output_error.OutputError`)."""
+        return tuple(Parameter(n, 0.0, scale=1.0 if n.endswith("hat") else 0.1) for n in self.names)
+
+    @property
+    def constants(self) -> Mapping[str, float]:
+        return MappingProxyType({})
+
+    def dynamics(self, t, x, u, theta: Mapping[str, np.ndarray], constants: Mapping[str, float]) -> np.ndarray:
+        """ẋ = A x + B u + b_x (Eq. 33a-b; the lateral model alike) for columns of x, u, θ."""
+        return self._linear(x, u, theta, constants, state=True)
+
+    def observe(self, t, x, u, theta: Mapping[str, np.ndarray], constants: Mapping[str, float]) -> np.ndarray:
+        """y = C x + D u + b_y (Eq. 33c) for columns of x, u, θ."""
+        return self._linear(x, u, theta, constants, state=False)
+
+    def _linear(self, x, u, theta, constants, state: bool) -> np.ndarray:
+        flight = flight_from_constants(constants)
+        x = np.atleast_2d(np.asarray(x, float))
+        K = x.shape[1]
+        u = np.broadcast_to(np.asarray(u, float).reshape(len(self.inputs), -1), (len(self.inputs), K))
+        cols = np.stack([np.broadcast_to(np.asarray(theta[n], float), (K,)) for n in self.names])
+        unique, inverse = np.unique(cols, axis=1, return_inverse=True)
+        nd, ns = len(self.derivatives), len(self.states)
+        out = np.empty((ns if state else len(self.outputs), K))
+        for c in range(unique.shape[1]):
+            sel = np.flatnonzero(inverse.ravel() == c)
+            A, B, C, D = self.matrices(dict(zip(self.derivatives, unique[:nd, c])), flight)
+            if state:
+                out[:, sel] = A @ x[:, sel] + B @ u[:, sel] + unique[nd:nd + ns, c][:, None]
+            else:
+                out[:, sel] = C @ x[:, sel] + D @ u[:, sel] + unique[nd + ns:, c][:, None]
+        return out
+
 
 def _short_period(d: Mapping[str, float], f: FlightConstants) -> Matrices:
     dim = short_period_dimensional(d["CZ_alpha"], d["CZ_qhat"], d["CZ_de"], d["Cm_alpha"], d["Cm_qhat"],
@@ -125,6 +163,39 @@ MODELS: Mapping[str, ModelSpec] = MappingProxyType({
 })
 LONGITUDINAL_COEFFICIENTS = ("CZ", "Cm", "CL", "CD", "CX")
 LATERAL_COEFFICIENTS = ("CY", "Cl", "Cn")
+
+
+def flight_from_constants(constants: Mapping[str, float]) -> FlightConstants:
+    """FlightConstants from a mapping with its field names, or the names of
+    :func:`estimators.dynamic_models.recording_constants` (``V0``, ``qbar0``, ``alpha0``, ``theta0``)."""
+    alias = {"qbar": "qbar0", "V": "V0", "alpha_o": "alpha0", "theta_o": "theta0"}
+    values = {}
+    for k in FlightConstants.__dataclass_fields__:
+        if k in constants:
+            values[k] = float(constants[k])
+        elif k in alias and alias[k] in constants:
+            values[k] = float(constants[alias[k]])
+    try:
+        return FlightConstants(**values)
+    except TypeError:
+        missing = [k for k in FlightConstants.__dataclass_fields__ if k not in values]
+        raise ValueError(f"the built-in linear models need the constants {missing}") from None
+
+
+def check_equation(spec: ModelSpec, equation: Equation | None) -> None:
+    """Refuse an equation whose dependent or regressors the model does not have: output error
+    fits the model's whole structure and must never echo a term it does not fit."""
+    if equation is None:
+        return
+    terms = {eq.dependent: eq.regressors for eq in spec.equations}
+    if equation.dependent not in terms:
+        raise ValueError(f"output error's {spec.name} model has no {equation.dependent} equation (it fits "
+                         f"{', '.join(terms)}): give a model of your own (--model-file) or use equation error")
+    extra = [r for r in equation.regressors if r not in terms[equation.dependent]]
+    if extra:
+        raise ValueError(f"output error's {spec.name} model has no {', '.join(extra)} term in {equation.dependent} "
+                         f"(it has {', '.join(terms[equation.dependent])}): give a model that has it "
+                         "(--model-file) or use equation error")
 
 
 def model_spec(model: str | None, equation: Equation | None = None) -> ModelSpec:

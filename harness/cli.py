@@ -60,11 +60,15 @@ def _parser() -> argparse.ArgumentParser:
                                    "(ee-smooth), in the frequency domain (ee-freq), or by output error "
                                    "(oe). Prints a table; --json writes every number.")
     e.add_argument("--recording", required=True, help="canonical recording (.csv/.parquet) or SIDPAC .mat")
-    e.add_argument("--dependent", required=True,
-                   help="CX, CY, CZ, Cl, Cm, Cn, CL or CD (from Eqs. 1-5, or the recording's own column)")
-    e.add_argument("--regressors", required=True,
+    e.add_argument("--dependent", default=None,
+                   help="CX, CY, CZ, Cl, Cm, Cn, CL or CD (from Eqs. 1-5, or the recording's own column); "
+                        "required unless --model-file is given")
+    e.add_argument("--regressors", default=None,
                    help="comma list: alpha, beta, qhat, phat, rhat, de, da, dr, dV, alphadot_hat, "
-                        "products a*b and powers a^2 ...")
+                        "products a*b and powers a^2 ...; required unless --model-file is given")
+    e.add_argument("--model-file", default=None,
+                   help="oe: a Python file defining `model` (estimators.dynamic_models.Model), fitted as written "
+                        "instead of the built-in linear models; the file is code that runs: use only files you trust")
     e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe"])
     e.add_argument("--errors", default=None, choices=["conventional", "colored"],
                    help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40); "

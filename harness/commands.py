@@ -95,13 +95,40 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise OptionError(f"--frequencies {args.frequencies!r} is not a band F0:DF:F1 in Hz, a comma list of "
                           f"frequencies, auto, eq18 or sidpac ({exc})") from None
+    if getattr(args, "model_file", None):
+        return _estimate_model_file(args)
+    if args.dependent is None or args.regressors is None:
+        raise OptionError("--dependent and --regressors are required (or --method oe --model-file FILE)")
     rec = read_recording(args.recording)
     equation = Equation.parse(args.dependent, args.regressors, bias=not args.no_bias and args.method != "ee-freq")
     data = DataOptions(angular_acceleration=args.angular_acceleration, reference=args.reference)
     estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
                                detrend=args.detrend, data=data)
     fit = estimator.fit(rec, equation)
-    print(f"{args.recording}: {equation.describe()}")
+    print(f"{args.recording}: " + (equation.describe() if args.method != "oe" else  # oe fits its model's terms
+                                   f"output error, {fit.info['model']} model, outputs {fit.dependent}"))
+    print(fit.summary())
+    if args.json:
+        write_json_atomic(args.json, fit.to_dict())
+        print(f"wrote {args.json}")
+    return 0
+
+
+def _estimate_model_file(args: argparse.Namespace) -> int:
+    """``estimate --method oe --model-file FILE``: output error for the model the file defines."""
+    from estimators.dynamic_models import load_model_file
+    from estimators.output_error import OutputError
+    from harness.recording_io import read_recording
+
+    if args.method != "oe":
+        raise OptionError(f"--model-file is for --method oe, not {args.method}")
+    if args.dependent is not None or args.regressors is not None:
+        raise OptionError("--model-file fits the model as the file writes it: leave out --dependent and --regressors")
+    model = load_model_file(args.model_file)
+    rec = read_recording(args.recording)
+    fit = OutputError(model=model).fit(rec)
+    print(f"{args.recording}: model {model.name} from {args.model_file} (outputs {', '.join(model.outputs)}; "
+          f"inputs {', '.join(model.inputs) or 'none'})")
     print(fit.summary())
     if args.json:
         write_json_atomic(args.json, fit.to_dict())
