@@ -86,6 +86,22 @@ def estimator_options(task: Task, method: str) -> dict:
     return out
 
 
+OUTPUT_ERROR = ("oe", "oe-freq", "fe")  # fit the whole model once per flight, whatever the equation
+
+
+def _output_error(method: str, model: str):
+    """The output-error family's estimator of a built-in model: time domain, frequency domain
+    or filter error (process noise)."""
+    if method == "oe-freq":
+        from estimators.frequency_output_error import FrequencyOutputError
+        return FrequencyOutputError(model=model)
+    if method == "fe":
+        from estimators.filter_error import FilterError
+        return FilterError(model=model)
+    from estimators.output_error import OutputError
+    return OutputError(model=model)
+
+
 def _model_of(equation: Equation) -> str:
     return "short-period" if equation.dependent in LONGITUDINAL else "lateral"
 
@@ -171,20 +187,20 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
     equations = excited_equations(clean, task.equations)
     prepared: dict[Equation, RegressionData] = {}  # one build per equation, shared by the methods
     for method in task.methods:
-        errs = task.errors if method in TIME_DOMAIN else (("cramer-rao",) if method == "oe" else ("conventional",))
+        errs = task.errors if method in TIME_DOMAIN else (("cramer-rao",) if method in OUTPUT_ERROR else ("conventional",))
         for errors in errs:
             for eq in equations:
                 base = common | {"method": method, "errors": errors, "equation": eq.describe(),
                                  "dependent": eq.dependent}
                 try:
-                    if method == "oe":
+                    if method in OUTPUT_ERROR:
                         model = _model_of(eq)
-                        if model not in oe_fits:
+                        if (method, model) not in oe_fits:
                             src = noisy  # output error always sees the measured outputs
                             t0 = time.perf_counter()
-                            from estimators.output_error import OutputError
-                            oe_fits[model] = (OutputError(model=model).fit(src, eq), time.perf_counter() - t0)
-                        fit, elapsed = oe_fits[model]
+                            oe_fits[(method, model)] = (_output_error(method, model).fit(src, eq),
+                                                        time.perf_counter() - t0)
+                        fit, elapsed = oe_fits[(method, model)]
                     else:
                         if eq not in prepared:
                             prepared[eq] = regression_with_noise(clean, noisy, eq, task.noise.apply_to, task, noise_model)
