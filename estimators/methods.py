@@ -7,7 +7,7 @@ from estimators.equation_error import SIDPAC_FREQUENCY_OPTIONS, EquationErrorFre
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit
 
-METHODS = ("ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq")
+METHODS = ("ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe")
 __all__ = ["METHODS", "SIDPAC_FREQUENCY_OPTIONS", "Estimator", "make_estimator", "parse_frequencies"]
 
 
@@ -38,7 +38,7 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
         return EquationErrorTime(errors=errors, max_lag=max_lag, data=data)
     if name == "ee-smooth":
         return EquationErrorTime(errors=errors, max_lag=max_lag, smooth_regressors=True, data=data)
-    if name in ("ee-freq", "oe", "oe-freq") and errors == "colored":
+    if name in ("ee-freq", "oe", "oe-freq", "fe") and errors == "colored":
         raise ValueError(f"--errors colored applies to the time-domain equation-error methods, not {name}: "
                          "the frequency-domain residuals are treated as white over the band (seed §III.E) "
                          "and output error reports the Cramér-Rao bound")
@@ -50,6 +50,9 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
     if name == "oe-freq":
         from estimators.frequency_output_error import FrequencyOutputError
         return FrequencyOutputError(data=data)
+    if name == "fe":
+        from estimators.filter_error import FilterError
+        return FilterError(data=data)
     raise ValueError(f"unknown method {name!r}; choose one of {METHODS}")
 
 

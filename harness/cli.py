@@ -69,7 +69,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--model-file", default=None,
                    help="oe: a Python file defining `model` (estimators.dynamic_models.Model), fitted as written "
                         "instead of the built-in linear models; the file is code that runs: use only files you trust")
-    e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq"])
+    e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe"])
     e.add_argument("--errors", default=None, choices=["conventional", "colored"],
                    help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40); "
                         "default colored for ee-smooth, conventional for ee-time")

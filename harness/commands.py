@@ -105,7 +105,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
                                detrend=args.detrend, data=data)
     fit = estimator.fit(rec, equation)
-    print(f"{args.recording}: " + (equation.describe() if not args.method.startswith("oe") else  # oe fits its model's terms
+    print(f"{args.recording}: " + (equation.describe() if args.method not in ("oe", "oe-freq", "fe") else  # oe fits its model's terms
                                    f"output error, {fit.info['model']} model, outputs {fit.dependent}"))
     print(fit.summary())
     if args.json:
