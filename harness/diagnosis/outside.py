@@ -429,7 +429,8 @@ def score(c: OutsideCase, result: dict) -> dict:
         false = [f for f in findings if f["effect"] != "none"]
         row.update(a=first["effect"] == "none", b=None, d=None)
     else:
-        false = [f for f in findings if _key(f) != (c.expect, c.parameter)]
+        # a ``none`` on an effect is a miss (criterion a), not a false finding
+        false = [f for f in findings if f["effect"] != "none" and _key(f) != (c.expect, c.parameter)]
         row["a"] = _key(first) == (c.expect, c.parameter)
         estimate = first["evidence"].get("change", first["estimate"]) if c.expect == "coefficient_error" \
             else first["estimate"]
