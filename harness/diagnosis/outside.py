@@ -538,6 +538,20 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def provenance() -> dict:
+    """The commit the sweep ran on and the files changed since (diagnosis work in progress shows)."""
+    import subprocess
+    root = Path(__file__).resolve().parents[2]
+
+    def git(*args: str) -> str:
+        try:
+            return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, timeout=10).stdout
+        except (OSError, subprocess.SubprocessError):
+            return ""
+    return {"commit": git("rev-parse", "HEAD").strip(),
+            "modified": [line[3:] for line in git("status", "--porcelain", "--untracked-files=no").splitlines()]}
+
+
 def sweep(out: str | Path, names: list[str] | None = None, workers: int = 2) -> list[dict]:
     """Run the outside sweep (the cases ``names``, default all) into ``out``; finished cases
     are read back, not run again."""
@@ -554,7 +568,8 @@ def sweep(out: str | Path, names: list[str] | None = None, workers: int = 2) -> 
     rows = [json.loads((out / "results" / f"{c.name}.json").read_text()) for c in chosen]
     write_text_atomic(out / "sweep.json", json.dumps(
         {"cases": [asdict(c) | {"effects": [e.describe() for e in c.effects]} for c in chosen],
-         "conditions": {k: asdict(v) for k, v in CONDITIONS.items()}, "rows": rows, "totals": totals(rows),
+         "conditions": {k: asdict(v) for k, v in CONDITIONS.items()}, "provenance": provenance(), "rows": rows,
+         "totals": totals(rows),
          "groups": groups(rows)}, indent=1, default=str))
     write_text_atomic(out / "sweep.md", markdown(rows))
     return rows
