@@ -83,8 +83,9 @@ def independent_f16_recording(path: Path, duration_s: float = 20.0) -> dict:
         "format": "flight-recording/1",
         "aircraft": "F-16 (JSBSim package model, stock)",
         "geometry": {"S_ft2": fdm["metrics/Sw-sqft"], "b_ft": fdm["metrics/bw-ft"], "cbar_ft": fdm["metrics/cbarw-ft"]},
-        "mass": {"mass_slug": mass, "Ix_slugft2": fdm["inertia/ixx-slugs_ft2"], "Iy_slugft2": fdm["inertia/iyy-slugs_ft2"],
-                 "Iz_slugft2": fdm["inertia/izz-slugs_ft2"], "Ixz_slugft2": abs(fdm["inertia/ixz-slugs_ft2"])},
+        "mass": {"mass_slug": mass, "Ix_slugft2": fdm["inertia/ixx-slugs_ft2"],
+                 "Iy_slugft2": fdm["inertia/iyy-slugs_ft2"], "Iz_slugft2": fdm["inertia/izz-slugs_ft2"],
+                 "Ixz_slugft2": abs(fdm["inertia/ixz-slugs_ft2"])},  # the seed's sign: positive for the F-16
         "sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]},
         "thrust_offset_ft": 0.0,
         "source": f"independent script (tests/test_outside.py), jsbsim {jsbsim.__version__}",
