@@ -113,7 +113,7 @@ def colored_forward_selection(z: npt.ArrayLike, candidates: Mapping[str, npt.Arr
         try:
             theta, se, _ = colored_fit(z, list(forced.values()) + [pool[n] for n in chosen + [best]], names, max_lag,
                                        constant)
-        except SingularRegressorsError:
+        except (SingularRegressorsError, np.linalg.LinAlgError):
             pool.pop(best)
             continue
         t = theta[len(names) - 1] / se[len(names) - 1] if se[len(names) - 1] > 0 else np.inf
@@ -137,7 +137,7 @@ def colored_forward_selection(z: npt.ArrayLike, candidates: Mapping[str, npt.Arr
         try:
             th, sn, r = colored_fit(z, list(forced.values()) + [pool[m] for m in chosen] + [pool[n]],
                                     names + [n], max_lag, constant)
-        except SingularRegressorsError:
+        except (SingularRegressorsError, np.linalg.LinAlgError):
             continue
         g = (float(resid @ resid) - float(r @ r)) / float(resid @ resid) if resid @ resid > 0 else 0.0
         j = len(names)

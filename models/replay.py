@@ -16,7 +16,7 @@ from models.aircraft import Aircraft, load_fdm
 from models.conditions import FlightCondition
 from models.flight import FlightHistory, fly
 from models.hidden import hidden_root, needs_copy
-from models.trim import TrimPoint, trim
+from models.trim import TrimError, TrimPoint, trim
 from models.truth import CoefficientProbe, central_differences, differencing_instance
 
 SURFACES = ("de", "da", "dr")
@@ -92,6 +92,7 @@ class AeroAlong:
     derivatives: dict[str, float]
     unsteady: dict[str, float]
     trim: TrimPoint
+    trim_failed: str = ""  # why the model could not trim there (derivatives then at the recorded start)
 
 
 def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np.ndarray],
@@ -105,7 +106,14 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     recorded ``alphadot`` (rad/s), since ``run_ic`` cannot know the α̇ of a recorded sample.
     """
     cond, kwargs = _instance(aircraft, ic, refs)
-    fdm, tp, gated = differencing_instance(aircraft, cond, **kwargs)
+    trim_failed = ""
+    try:
+        fdm, tp, gated = differencing_instance(aircraft, cond, **kwargs)
+    except TrimError as exc:  # the coefficients along the states need no equilibrium
+        trim_failed = str(exc)
+        start = {k: float(np.asarray(states[k])[0]) for k in ("alpha", "beta", "theta", "phi") if k in states}
+        start.update({s: float(np.asarray(v)[0]) for s, v in surfaces.items()})
+        fdm, tp, gated = differencing_instance(aircraft, cond, at=start, **kwargs)
     probe = CoefficientProbe(fdm, aircraft, tp, gated)
     derivatives = central_differences(probe)
     unsteady = probe.unsteady_derivatives()
@@ -146,7 +154,7 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     if bad:
         raise ValueError(f"the model's aerodynamics are not finite along the recording ({', '.join(bad)}); "
                          "the recorded states leave the model's tables")
-    return AeroAlong(coefficients=out, derivatives=derivatives, unsteady=unsteady, trim=tp)
+    return AeroAlong(coefficients=out, derivatives=derivatives, unsteady=unsteady, trim=tp, trim_failed=trim_failed)
 
 
 def initial_condition(t: np.ndarray, V: np.ndarray, alpha: np.ndarray, h: np.ndarray | None,

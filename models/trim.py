@@ -333,6 +333,35 @@ def _why_not(eq: _Equilibrium | None) -> str:
             f"{eq.residual:.2g})")
 
 
+def place_untrimmed(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition,
+                    state: dict[str, float]) -> TrimPoint:
+    """Put ``fdm`` (freshly loaded) at ``condition``'s altitude and airspeed and at ``state``
+    (``alpha``, ``beta``, ``theta``, ``phi`` in rad; surfaces ``de``, ``da``, ``dr``), in
+    cruise configuration with the FCS disabled, without looking for an equilibrium: for
+    evaluating the aerodynamics where the model cannot trim (the returned point's ``method``
+    is ``'untrimmed'``; its accelerations are not zero)."""
+    set_initial_condition(fdm, condition.h_ft, condition.V_fps)
+    config = cruise_configuration(model_xml(aircraft.model))
+    written = command_configuration(fdm, config)
+    fdm["propulsion/set-running"] = -1
+    fdm.run_ic()
+    written.update(place_configuration(fdm, config))
+    place_reference_point(fdm, aircraft)
+    fdm["simulation/models/FGFCS/enabled"] = 0
+    set_initial_condition(fdm, condition.h_ft, condition.V_fps)
+    for key, prop in (("alpha", "ic/alpha-rad"), ("beta", "ic/beta-rad"), ("theta", "ic/theta-rad"),
+                      ("phi", "ic/phi-rad")):
+        if key in state:
+            fdm[prop] = float(state[key])
+    for s, prop in aircraft.surfaces.items():
+        if s in state:
+            fdm[prop] = float(state[s])
+    fdm.run_ic()
+    fdm["propulsion/fuel_freeze"] = 1
+    return read_trim_point(fdm, condition.name, aircraft.surfaces,
+                           configuration=configuration_record(fdm, config, written), method="untrimmed")
+
+
 _PROP_MOMENTS = ("moments/l-prop-lbsft", "moments/m-prop-lbsft", "moments/n-prop-lbsft")
 
 

@@ -28,7 +28,7 @@ import numpy as np
 from models.aircraft import Aircraft, load_fdm, model_xml, nominal_tree
 from models.conditions import FlightCondition
 from models.jsbsim_root import cached_root
-from models.trim import TrimPoint, trim
+from models.trim import TrimPoint, place_untrimmed, trim
 
 LONGITUDINAL_COEFFICIENTS = ("CL", "CD", "CX", "CZ", "Cm")
 LONGITUDINAL_VARIABLES = ("alpha", "qhat", "de")
@@ -234,8 +234,14 @@ def excursion_from_history(channels: Mapping[str, np.ndarray], tp: TrimPoint) ->
 
 
 def differencing_instance(aircraft: Aircraft, condition: FlightCondition, *,
-                          root=None, name=None, dt: float = 1 / 120) -> tuple[jsbsim.FGFDMExec, TrimPoint, bool]:
-    """A trimmed instance of ``aircraft`` whose α̇/β̇ aerodynamic terms are gated (if any)."""
+                          root=None, name=None, dt: float = 1 / 120,
+                          at: Mapping[str, float] | None = None) -> tuple[jsbsim.FGFDMExec, TrimPoint, bool]:
+    """A trimmed instance of ``aircraft`` whose α̇/β̇ aerodynamic terms are gated (if any).
+
+    With ``at`` (a state: ``alpha``, ``beta``, ``theta``, ``phi`` in rad, surfaces ``de``,
+    ``da``, ``dr``) the instance is not trimmed but put at that state at the condition's
+    altitude and airspeed (:func:`models.trim.place_untrimmed`): the derivatives are then
+    those at a recorded state rather than at an equilibrium."""
     if root is None:
         tree, source = nominal_tree(aircraft.model), model_xml(aircraft.model)
     else:
@@ -249,7 +255,7 @@ def differencing_instance(aircraft: Aircraft, condition: FlightCondition, *,
         fdm = load_fdm(aircraft, dt)
     if gated:
         fdm[UNSTEADY_GAIN] = 1.0  # trim with the aircraft as it flies
-    tp = trim(fdm, aircraft, condition)
+    tp = trim(fdm, aircraft, condition) if at is None else place_untrimmed(fdm, aircraft, condition, at)
     return fdm, tp, gated
 
 

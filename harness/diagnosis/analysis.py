@@ -57,6 +57,7 @@ class Analysis:
     offset: cand.OffsetTest
     gust: object
     peak: object
+    not_offered: dict = field(default_factory=dict)  # per axis: candidate parameters the maneuver did not excite
 
 
 def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
@@ -118,15 +119,22 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         p = replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
     # 2. the model along the measured states
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
+    # a state the maneuver did not drive is held at its start: evaluated along its noise, the
+    # model would pass that noise on through its derivative (errors in variables), and the
+    # mismatch would then show the derivative itself as "wrong"
+    for k in ("alpha", "beta", "p", "q", "r"):
+        if k in states and k not in p.driven:
+            states[k] = np.full(p.n, p.start[k])
+    surfaces = {s: (p.smooth[s] if s in p.driven else np.full(p.n, p.start[s]))
+                for s in ("de", "da", "dr") if s in p.smooth}
     # airspeed and altitude are slow: their own optimal smoothing (a far lower cut-off than the
     # common filter's) keeps their noise out of the model's coefficients (through q̂ = qc̄/2V,
     # dynamic pressure and Mach-scheduled terms)
     for k in ("V", "h"):
         if k in p.smooth and k in p.own_noise:
             states[k] = p.raw[k] - p.own_noise[k]
-    aero = aero_along(aircraft, ic, states, {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth},
-                      p.deriv["alpha"])
-    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, aero.trim.thrust_lbf)
+    aero = aero_along(aircraft, ic, states, surfaces, p.deriv["alpha"] if "alpha" in p.driven else None)
+    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
     mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches
@@ -154,12 +162,27 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             delays[s] = scan
     # 5. per-axis stepwise
     selections = {}
+    not_offered: dict[str, list[str]] = {}
+    shares: dict[tuple[str, str], float] = {}
+    inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
     for axis in COEFFICIENTS:
-        terms = cand.library(p, axis, aero.derivatives, measured, aero.coefficients)
+        terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
+        not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
+                             for t in skipped]
+        if axis == "CX" and "thrust" not in p.raw:
+            # thrust held constant (not recorded): a jet's thrust changes with airspeed at a
+            # fixed throttle, and that change is what a CX drift term would fit
+            not_offered[axis] += [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources),
+                                   "reason": NO_THRUST_DRIFT} for t in terms if t.key == "dV"]
+            terms = [t for t in terms if t.key != "dV"]
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
         sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra)
-        selections[axis] = (sel, {t.key: t for t in terms})
-    cands += _aero_candidates(selections, delays, p.dt)
+        by_key = {t.key: t for t in terms}
+        for t in sel.terms:
+            column = by_key[t.name].column if t.name in by_key else extra[t.name]
+            shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
+        selections[axis] = (sel, by_key)
+    cands += _aero_candidates(selections, delays, p.dt, shares)
     # 6. spectra and gusts
     peak = structural_peak(p)
     if peak is not None:
@@ -176,9 +199,19 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                            f"gust/noise ratio {gust.ratio_to_noise:.1f}",
                            {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}))
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
-                    selections=selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak)
+                    selections=selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
+                    not_offered=not_offered)
 
 
+def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
+    """Thrust for Eqs. 1 and 4 when the recording has no thrust channel: constant at trim
+    (recording-format.md), the metadata's trim thrust when given, else the model's."""
+    given = (p.meta.get("trim") or {}).get("thrust_lbf")
+    return float(given) if given is not None else float(model_trim_thrust_lbf)
+
+
+NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX cannot be told from the "
+                   "thrust's own change with airspeed")
 GUST_RATIO = 4.0     # the integrated kinematic residual over what sensor noise alone gives
 GUST_MIN_FPS = 3.0   # and at least light turbulence's RMS gust
 NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"
@@ -200,7 +233,18 @@ def _practical_size(name: str, dt: float) -> float:
 PRACTICAL_DELAY_SAMPLES = 2.0
 
 
-def _aero_candidates(selections: dict, delays: dict, dt: float) -> list[Candidate]:
+def _practical(share: float) -> bool:
+    return share >= cand.PRACTICAL_SHARE
+
+
+def _impractical_reason(share: float) -> str:
+    return (f"entered, but too small to matter: it explains {100 * share:.1f} % of the coefficient's excursion "
+            f"(under {100 * cand.PRACTICAL_SHARE:.0f} %)")
+
+
+def _aero_candidates(selections: dict, delays: dict, dt: float,
+                     shares: dict[tuple[str, str], float] | None = None) -> list[Candidate]:
+    shares = shares or {}
     out: list[Candidate] = []
     delay_seen: dict[str, list] = {}
     cg_seen: list = []
@@ -216,9 +260,11 @@ def _aero_candidates(selections: dict, delays: dict, dt: float) -> list[Candidat
             est, se = t.estimate * term.scale, abs(t.std_error * term.scale)
             if term.effect == "coefficient_error":
                 est = term.details["model_value"] + t.estimate
+            share = shares.get((axis, t.name), 0.0)
+            sel = t.selected and _practical(share)
+            reason = ("entered" if sel else _impractical_reason(share) if t.selected else "not entered")
             out.append(Candidate(term.effect, cand.AXIS_NAME[axis], axis, term.parameter, est, se, t.t, t.gain,
-                                 term.units, f"stepwise on the {axis} mismatch", t.selected,
-                                 "entered" if t.selected else "not entered",
+                                 term.units, f"stepwise on the {axis} mismatch", sel, reason,
                                  {"change": t.estimate, "model_over_maneuver": term.details["model_value"],
                                   "model_at_trim": term.details["trim_value"]}
                                  if term.effect == "coefficient_error" else {}))
@@ -227,7 +273,7 @@ def _aero_candidates(selections: dict, delays: dict, dt: float) -> list[Candidat
         # significance from the stepwise entry of the delay column (its coefficient is τ);
         # size and standard error from the scan's linearised fit
         best = max(rows, key=lambda r: abs(r[1].t))[1]
-        entered = any(t.selected for _, t in rows)
+        entered = any(t.selected and _practical(shares.get((a, t.name), 0.0)) for a, t in rows)
         inside = scan.tau_s <= cand.DELAY_GRID_S[-1]
         sel = entered and inside and scan.tau_s >= PRACTICAL_DELAY_SAMPLES * dt
         gain = max(t.gain for _, t in rows)
@@ -239,7 +285,9 @@ def _aero_candidates(selections: dict, delays: dict, dt: float) -> list[Candidat
                              {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
     if cg_seen:
         axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))
+        sel = any(r[1].selected and _practical(shares.get((r[0], r[1].name), 0.0)) for r in cg_seen)
         out.append(Candidate("cg_offset", cand.AXIS_NAME[axis], axis, term.parameter, t.estimate * term.scale,
                              abs(t.std_error * term.scale), t.t, t.gain, "ft", f"stepwise on the {axis} mismatch",
-                             any(r[1].selected for r in cg_seen), "entered" if t.selected else "not entered"))
+                             sel, "entered" if sel else (_impractical_reason(shares.get((axis, t.name), 0.0))
+                                                         if t.selected else "not entered")))
     return out

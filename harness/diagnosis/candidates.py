@@ -38,6 +38,7 @@ class Term:
     column: np.ndarray
     scale: float = 1.0
     details: dict = field(default_factory=dict)
+    sources: tuple[str, ...] = ()  # the states/surfaces the column is built on (all must be driven)
 
 
 def _hat(p: Prepared, rate: str, length: float) -> np.ndarray:
@@ -92,24 +93,60 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
         if r in reg:
             terms.append(Term(r, "coefficient_error", f"{axis}_{r}", units_rate, reg[r],
                               details={"model_value": values.get(f"{axis}_{r}", float("nan")),
-                                       "trim_value": derivatives.get(f"{axis}_{r}", float("nan"))}))
+                                       "trim_value": derivatives.get(f"{axis}_{r}", float("nan"))},
+                              sources=(REGRESSOR_SOURCE[r],)))
     if axis in LON:
         adot = p.deriv["alpha"] * geo["cbar_ft"] / (2.0 * p.smooth["V"])
-        terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)", adot))
-        terms.append(Term("alpha2", "nonlinear_alpha", f"{axis}_alpha2", "per rad^2", a ** 2))
-        terms.append(Term("alpha3", "nonlinear_alpha", f"{axis}_alpha3", "per rad^3", a ** 3))
+        terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)", adot,
+                          sources=("alpha",)))
+        terms.append(Term("alpha2", "nonlinear_alpha", f"{axis}_alpha2", "per rad^2", a ** 2, sources=("alpha",)))
+        terms.append(Term("alpha3", "nonlinear_alpha", f"{axis}_alpha3", "per rad^3", a ** 3, sources=("alpha",)))
     else:
-        terms.append(Term("alpha_beta", "cross_coupling", f"{axis}_alpha_beta", "per rad^2", a * reg["beta"]))
+        terms.append(Term("alpha_beta", "cross_coupling", f"{axis}_alpha_beta", "per rad^2", a * reg["beta"],
+                          sources=("alpha", "beta")))
         # a response even in sideslip: wrong for a symmetric airframe, yet easy to tabulate (β
         # itself, not its change from the start: the kink is at zero sideslip)
-        terms.append(Term("beta_abs", "cross_coupling", f"{axis}_beta_abs", "per rad", np.abs(p.smooth["beta"])))
+        terms.append(Term("beta_abs", "cross_coupling", f"{axis}_beta_abs", "per rad", np.abs(p.smooth["beta"]),
+                          sources=("beta",)))
     V0 = p.start["V"]
-    terms.append(Term("dV", "flight_condition_drift", f"{axis}_dV", "per unit dV/V", (p.smooth["V"] - V0) / V0))
+    # on a lateral axis the drift term also needs the lateral motion it would scale
+    terms.append(Term("dV", "flight_condition_drift", f"{axis}_dV", "per unit dV/V", (p.smooth["V"] - V0) / V0,
+                      sources=("V",) if axis in LON else ("V", "beta")))
     if axis == "Cm":
-        terms.append(Term("cg", "cg_offset", "dx_moment_reference", "ft", measured["CZ"], scale=geo["cbar_ft"]))
+        terms.append(Term("cg", "cg_offset", "dx_moment_reference", "ft", measured["CZ"], scale=geo["cbar_ft"],
+                          sources=("alpha",)))
     if axis == "Cn":
-        terms.append(Term("cg", "cg_offset", "dx_moment_reference", "ft", measured["CY"], scale=-geo["b_ft"]))
+        terms.append(Term("cg", "cg_offset", "dx_moment_reference", "ft", measured["CY"], scale=-geo["b_ft"],
+                          sources=("beta",)))
     return terms
+
+
+# The recorded channel each of the model's own regressors is built on.
+REGRESSOR_SOURCE = {"alpha": "alpha", "qhat": "q", "de": "de", "beta": "beta", "phat": "p", "rhat": "r",
+                    "da": "da", "dr": "dr"}
+
+
+def offered(p: Prepared, terms: list[Term]) -> tuple[list[Term], list[Term]]:
+    """The terms whose every source the maneuver drove (:attr:`Prepared.driven`), and the
+    others: a column built on a state the maneuver did not move is that state's noise, and
+    its coefficient would only measure how the model's derivative passes the noise on."""
+    driven = set(p.driven)
+    keep = [t for t in terms if set(t.sources) <= driven]
+    return keep, [t for t in terms if not set(t.sources) <= driven]
+
+
+def contribution_share(column: np.ndarray, coefficient: float, measured: np.ndarray) -> float:
+    """A term's practical size: the RMS of what it adds to the coefficient (coefficient ×
+    its column, about the mean) over the RMS excursion of the measured coefficient."""
+    excursion = float(np.std(measured))
+    return float(abs(coefficient) * np.std(column) / excursion) if excursion > 0 else 0.0
+
+
+# The smallest share of the coefficient's excursion a term must explain to be a finding
+# (its practical significance, whatever its t): noise-free recordings of the model itself
+# give up to 0.017 (filtering and sample-timing artefacts, F-16 three-axis), the project's
+# concealed effects 0.09-0.39 (gallery and sweep, realistic noise).
+PRACTICAL_SHARE = 0.04
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ import numpy as np
 
 from estimators.coefficients import accelerometer_at_cg, force_coefficients, moment_coefficients
 from estimators.smoothing import optimal_fourier_smoother, sine_series_derivative, sine_series_filter
+from harness.isa import density_altitude_ft
 from maneuvers.recording import Recording
 
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
@@ -18,6 +19,13 @@ UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi
 BANDWIDTH_CHANNELS = ("alpha", "beta", "p", "q", "r")
 COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 START_WINDOW_S = 0.5
+# The states each group of surfaces drives: a state is maneuver-driven only when a surface of
+# its group moved (a symmetric airframe's pitch maneuver leaves β, p and r at their noise).
+DRIVEN_BY = {"alpha": ("de",), "q": ("de",), "theta": ("de",), "V": ("de",),
+             "beta": ("da", "dr"), "p": ("da", "dr"), "r": ("da", "dr"), "phi": ("da", "dr")}
+# A driven state's filtered signal must stand this many times above the white noise the
+# common filter lets through (sigma * sqrt(mean(w^2)), Parseval on the sine series).
+DRIVEN_SNR = 5.0
 
 
 @dataclass(frozen=True)
@@ -32,6 +40,10 @@ class Prepared:
     noise_std, cutoff_hz : each channel's own optimal-smoother noise level and cut-off.
     weights, common_cutoff_hz : the common filter (sine-series weights) and its cut-off.
     excited : the channels whose signal stands clear of their noise.
+    driven : the states the maneuver drove (:func:`maneuver_driven`) and the surfaces that
+        moved: the only ones a candidate term may be built on, and the only states the model
+        is evaluated along (the others are held at their start values: their noise, passed
+        through the model's derivatives, would look like a wrong derivative).
     measured : coefficients (Eqs. 1-5) from the filtered channels.
     start : the recording's initial values (means over the first 0.5 s of ``smooth``).
     meta : the recording's metadata.
@@ -55,6 +67,8 @@ class Prepared:
     meta: dict = field(default_factory=dict)
     own_noise: dict[str, np.ndarray] = field(default_factory=dict)  # raw − each channel's own optimal smoothing
     mass: dict[str, np.ndarray] = field(default_factory=dict)
+    driven: tuple[str, ...] = ()
+    assumptions: tuple[dict, ...] = ()  # what stood in for missing channels or metadata
 
     @property
     def n(self) -> int:
@@ -104,6 +118,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     if t[-1] < 4.0:
         raise ValueError(f"recording {rec.name!r} is {t[-1]:.1f} s long; the diagnosis needs at least 4 s")
     dt = float((t[-1] - t[0]) / (t.size - 1))
+    assumptions = list(_stand_ins(raw, rec.meta, tuple(rec.data.columns)))
     fits = {c: optimal_fourier_smoother(x, dt) for c, x in raw.items()}
     noise = {c: float(np.sqrt(max(f.noise_variance, 0.0))) for c, f in fits.items()}
     excited = tuple(c for c, f in fits.items()
@@ -120,10 +135,76 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     except (KeyError, ValueError) as exc:
         raise ValueError(f"recording {rec.name!r} lacks mass properties Eqs. 1-5 need: {exc}") from exc
     measured = measured_coefficients(smooth, deriv, rec.meta, mass)
+    driven = maneuver_driven(smooth, noise, w, excited)
+    own_noise = {c: np.asarray(f.noise) for c, f in fits.items()}
+    if "h" not in raw:
+        # pressure altitude from the density that q̄ and V imply (ISA, standard day)
+        rho = 2.0 * (raw["qbar"] - own_noise["qbar"]) / (raw["V"] - own_noise["V"]) ** 2
+        h = density_altitude_ft(np.clip(rho, 1e-6, None))
+        raw["h"], smooth["h"], deriv["h"] = h, sine_series_filter(h, w), sine_series_derivative(h, w, dt)
+        own_noise["h"] = np.zeros_like(h)
+        start["h"] = float(np.mean(smooth["h"][:k]))
+        assumptions.append({"item": "altitude", "missing": "h channel",
+                            "stood_in_by": f"the ISA altitude of the density 2 q̄ / V² ({start['h']:.0f} ft at the "
+                                           "start; a standard day assumed)"})
     return Prepared(name=name, t=t, dt=dt, raw=raw, smooth=smooth, deriv=deriv, noise_std=noise,
                     cutoff_hz={c: f.cutoff_hz for c, f in fits.items()}, weights=w, common_cutoff_hz=cutoff,
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
-                    own_noise={c: np.asarray(f.noise) for c, f in fits.items()}, mass=mass)
+                    own_noise=own_noise, mass=mass, driven=driven, assumptions=tuple(assumptions))
+
+
+def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...]) -> list[dict]:
+    """What the recording leaves out and what the diagnosis assumes instead (altitude is
+    handled in :func:`prepare`; thrust's value is the analysis's)."""
+    out = []
+    if "thrust" not in raw:
+        trim_thrust = (meta.get("trim") or {}).get("thrust_lbf")
+        out.append({"item": "thrust", "missing": "thrust channel",
+                    "stood_in_by": (f"constant at the metadata's trim thrust, {trim_thrust:.0f} lbf "
+                                    "(recording-format: constant at trim)" if trim_thrust is not None else
+                                    "constant at the model's trim thrust at the recording's start "
+                                    "(recording-format: constant at trim; the metadata give none)")})
+    if "mass_slug" not in columns:
+        out.append({"item": "mass and inertia", "missing": "mass channels",
+                    "stood_in_by": "the metadata's constants, for the whole maneuver"})
+    sensors = meta.get("sensors") or {}
+    if "accelerometer_ft" not in sensors:
+        out.append({"item": "accelerometer position", "missing": "sensors.accelerometer_ft",
+                    "stood_in_by": "at the c.g. (any offset is then a finding, sensor_offset)"})
+    out.append({"item": "angle-of-attack and sideslip vanes", "missing": "vane positions",
+                "stood_in_by": "α and β taken as measured at the c.g. (a vane offset is then a finding)"})
+    out.append({"item": "angular rates", "missing": "-",
+                "stood_in_by": "p, q, r taken as the body rates the aerodynamics see (still air; inertial and "
+                               "Earth-relative rates differ by at most 7.3e-5 rad/s)"})
+    return out
+
+
+def filtered_noise_std(noise_std: float, weights: np.ndarray) -> float:
+    """The standard deviation white noise of ``noise_std`` keeps through the sine-series
+    filter ``weights``: by Parseval on the orthogonal sine basis, sigma * sqrt(mean(w^2))."""
+    return float(noise_std * np.sqrt(np.mean(np.asarray(weights) ** 2)))
+
+
+def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weights: np.ndarray,
+                    excited: tuple[str, ...], snr: float = DRIVEN_SNR) -> tuple[str, ...]:
+    """The surfaces that moved and the states the maneuver drove.
+
+    A surface counts when it is ``excited`` (its smoothed signal at least 5 times its noise).
+    A state counts when a surface of its group moved (:data:`DRIVEN_BY`: the lateral states
+    need an aileron or rudder input, the longitudinal ones a stabilator input) *and* its
+    filtered, detrended signal stands ``snr`` times above the white noise the filter passes.
+    Coloured sensor noise inside the band can pass the second test; the first is what keeps
+    a pitch maneuver's β, p and r out of the analysis."""
+    surfaces = [s for s in ("de", "da", "dr") if s in excited]
+    out = list(surfaces)
+    for state, group in DRIVEN_BY.items():
+        if state not in smooth or not any(g in surfaces for g in group):
+            continue
+        x = smooth[state]
+        signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
+        if signal >= snr * max(filtered_noise_std(noise.get(state, 0.0), weights), 1e-12):
+            out.append(state)
+    return tuple(out)
 
 
 def measured_coefficients(s: dict[str, np.ndarray], d: dict[str, np.ndarray], meta: dict,
@@ -144,3 +225,27 @@ def measured_coefficients(s: dict[str, np.ndarray], d: dict[str, np.ndarray], me
                                   mass["Ix_slugft2"], mass["Iy_slugft2"], mass["Iz_slugft2"], mass["Ixz_slugft2"],
                                   thrust, meta.get("thrust_offset_ft", 0.0))
     return {**forces, **{k: moments[k] for k in ("Cl", "Cm", "Cn")}}
+
+
+_SOURCE_WORDS = {"alpha": "α", "beta": "β", "p": "the roll rate", "q": "the pitch rate", "r": "the yaw rate",
+                 "V": "the airspeed", "de": "the stabilator", "da": "the aileron", "dr": "the rudder"}
+
+
+def undriven_reason(p: Prepared, sources: list[str] | tuple[str, ...]) -> str:
+    """Why a term built on ``sources`` could not be tested on this recording."""
+    missing = [s for s in sources if s not in p.driven]
+    lateral = any(s in p.driven for s in ("da", "dr"))
+    longitudinal = "de" in p.driven
+    words = []
+    for s in missing:
+        if s in ("beta", "p", "r") and not lateral:
+            words.append("no lateral input (aileron and rudder never moved)")
+        elif s in ("alpha", "q", "V") and not longitudinal:
+            words.append("no longitudinal input (the stabilator never moved)")
+        elif s in ("de", "da", "dr"):
+            words.append(f"{_SOURCE_WORDS[s]} never moved")
+        elif s == "V":
+            words.append("the airspeed never moved above its noise (no phugoid)")
+        else:
+            words.append(f"{_SOURCE_WORDS.get(s, s)} never moved above its noise")
+    return "; ".join(dict.fromkeys(words)) or "not excited"

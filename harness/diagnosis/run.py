@@ -15,7 +15,7 @@ from harness.atomic import write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
-from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
+from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason
 from harness.recording_io import read_recording
 from models.aircraft import MODELS, Aircraft, is_xml_model, nominal_root
 from models.hidden import HiddenEffect, hidden_root
@@ -201,9 +201,13 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
     the identification's findings are applied as predictions."""
     ic = analysis.ic
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
-    before_hist, _ = replay(aircraft, ic, p.t, surfaces)
-    after_hist, diverged = before_hist, None
-    if added:
+    before_hist, before_failed = None, None
+    try:
+        before_hist, _ = replay(aircraft, ic, p.t, surfaces)
+    except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
+        before_failed = str(exc)
+    after_hist, diverged = before_hist, before_failed
+    if added and before_failed is None:
         try:
             after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), _true_start(p, added), p.t, surfaces)
         except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient fits still stand
@@ -212,13 +216,17 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
     before_mm = a.mismatch
     after_mm, n_terms = _after_mismatch(a, findings or [])
     inner = _inner(p)
-    sim_b = _sim_channels(before_hist)
-    sim_a = _sim_channels(after_hist) if after_hist is not None else {c: np.full(p.n, np.nan) for c in sim_b}
-    fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner),
+    nan = {c: np.full(p.n, np.nan) for c in _CHANNEL_COLUMNS}
+    sim_b = _sim_channels(before_hist) if before_hist is not None else nan
+    sim_a = _sim_channels(after_hist) if after_hist is not None else nan
+    fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner) if before_failed is None else {},
              "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
     fit_a = {"outputs": output_fit(p.smooth, p.raw, sim_a, OUTPUTS, inner) if diverged is None else {},
              "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
-    if diverged is not None:
+    if before_failed is not None:
+        fit_b["replay_failed"] = f"the model could not replay this maneuver: {before_failed}"
+        fit_a["replay_failed"] = fit_b["replay_failed"]
+    elif diverged is not None:
         fit_a["replay_failed"] = f"the augmented model could not replay this maneuver: {diverged}"
     series = {"t_s": p.t}
     for c in OUTPUTS:
@@ -359,6 +367,100 @@ def _none_finding(a: Analysis, fits_b: dict) -> dict:
                            "mismatch is explained by measurement noise alone."}
 
 
+# The factor by which the model's lift along the recorded states may differ from the
+# measured before the model is refused as another aircraft. None of the effects of
+# effects.md comes near it: a 3-degree alpha bias moves the F-16's lift by about 25 %; the
+# Twin Otter against JSBSim's DHC6 differs by 6 %, an F-16 recording against the 737 by 49 %
+# and the Twin Otter against the F-16 by a factor of 3.2.
+LIFT_FACTOR = 1.5
+# The factor by which the recording's reference geometry (S, b, c̄) may differ from the
+# model's: coefficients are normalised by them, so a model of another size is another
+# aircraft (the F-16's S is 300 ft², the 737's 1,171 ft², the Twin Otter's 420 ft² in both the
+# SIDPAC file and JSBSim's DHC6).
+GEOMETRY_FACTOR = 1.25
+
+
+def check_model_represents(a: Analysis, model: str) -> None:
+    """Refuse a model that cannot stand for the recorded aircraft: its reference geometry
+    differs from the recording's by more than :data:`GEOMETRY_FACTOR`, or its normal-force
+    coefficient along the recorded states differs from the measured one by more than
+    :data:`LIFT_FACTOR` (skipped when the measured mean is under 0.05, near zero lift).
+
+    Raises
+    ------
+    DiagnosisError
+        Naming the model, both lift levels and why no effect explains the difference.
+    """
+    geometry = a.prepared.meta["geometry"]
+    tp = a.aero.trim
+    for key, value, label in (("S_ft2", tp.S_ft2, "wing area"), ("b_ft", tp.b_ft, "span"),
+                              ("cbar_ft", tp.cbar_ft, "mean chord")):
+        ratio = float(geometry[key]) / value if value > 0 else float("inf")
+        if not 1.0 / GEOMETRY_FACTOR <= ratio <= GEOMETRY_FACTOR:
+            raise DiagnosisError(
+                f"--model {model} does not represent the recorded aircraft: the recording's {label} is "
+                f"{float(geometry[key]):g} ({key}) where the model's is {value:g}, a factor of "
+                f"{max(ratio, 1 / ratio):.2f} (beyond {GEOMETRY_FACTOR:g}): another aircraft, or another "
+                "reference geometry for the coefficients")
+    measured = float(np.mean(a.mismatch["CZ"] + a.aero.coefficients["CZ"]))
+    modelled = float(np.mean(a.aero.coefficients["CZ"]))
+    if abs(measured) < 0.05:
+        return
+    ratio = modelled / measured
+    if not 1.0 / LIFT_FACTOR <= ratio <= LIFT_FACTOR:
+        trim = f" (and it cannot trim there: {a.aero.trim_failed})" if a.aero.trim_failed else ""
+        raise DiagnosisError(
+            f"--model {model} does not represent the recorded aircraft: along the recorded states its normal-force "
+            f"coefficient averages {modelled:.3f} where the recording's is {measured:.3f} (a factor of "
+            f"{max(ratio, 1 / ratio) if ratio > 0 else float('inf'):.2f}, beyond {LIFT_FACTOR:g}){trim}; no effect the "
+            "diagnosis can name explains that much")
+
+
+def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
+    """The effects (or their parameters) this recording cannot test, each with the reason:
+    terms built on states or surfaces the maneuver did not drive, delays of surfaces that
+    never moved, sensor scale factors and skews of channels that hardly move, what the
+    sample rate hides, and the missing validation maneuver."""
+    p = a.prepared
+    grouped: dict[tuple[str, str], list[str]] = {}
+    for rows in a.not_offered.values():
+        for r in rows:
+            why = r.get("reason") or undriven_reason(p, r["sources"])
+            grouped.setdefault((r["effect"], why), []).append(r["parameter"])
+    for s in SURFACES:
+        if s in p.raw and s not in p.driven:
+            grouped.setdefault(("control_delay", undriven_reason(p, [s])), []).append(f"tau_{s}")
+    for name, why in a.kinematic.dropped.items():
+        kind = name.split("_", 1)[0]
+        effect = {"scale": "sensor_scale", "skew": "sensor_time_skew"}.get(kind, "sensor_" + kind)
+        grouped.setdefault((effect, why), []).append(name)
+    out = [{"effect": e, "parameters": sorted(dict.fromkeys(ps)), "reason": why} for (e, why), ps in grouped.items()]
+    out.append({"effect": "structural_mode", "parameters": [],
+                "reason": f"only modes below {0.5 / p.dt:g} Hz (half the sample rate) can be seen"})
+    if not validation_given:
+        out.append({"effect": "(every finding)", "parameters": [],
+                    "reason": "no validation maneuver was given: no finding was tested on a second maneuver"})
+    return out
+
+
+def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
+    """What the diagnosis assumed: the recording's stand-ins (:attr:`Prepared.assumptions`),
+    with the thrust value used, and the mass the model flew with."""
+    out = [dict(x) for x in a.prepared.assumptions]
+    for x in out:
+        if x["item"] == "thrust" and "model's" in x["stood_in_by"]:
+            x["stood_in_by"] += f": {a.aero.trim.thrust_lbf:.0f} lbf"
+    out.append({"item": "model mass", "missing": "-",
+                "stood_in_by": ("the recording's mass and inertia (first sample)" if mass == "recording" else
+                                f"the model's own mass and inertia ({aircraft.name}); --mass recording flies it "
+                                "with the recording's")})
+    trim = a.aero.trim
+    if trim.held:
+        for surface, info in trim.held.items():
+            out.append({"item": f"model trim ({surface})", "missing": "-", "stood_in_by": info["reason"]})
+    return out
+
+
 def _with_recorded_mass(aircraft: Aircraft, rec) -> Aircraft:
     """The aircraft with the recording's mass and inertia (its first sample), as an XML copy."""
     try:
@@ -438,6 +540,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     p = prepare(rec, "identification")
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
     a = analyse(p, aircraft, ic)
+    check_model_represents(a, model)
     findings = _findings(a)
     checks: dict[int, dict | None] = {}
     av = None
@@ -479,6 +582,8 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         "findings": [_finding_dict(f, fits_b, fits_a, checks.get(id(f))) for f in findings]
         or [_none_finding(a, fits_b)],
         "located": located,
+        "assumptions": assumptions(a, aircraft, mass),
+        "not_checked": not_checked(a, validation is not None),
         "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
         "candidates": [c.as_dict() for c in sorted(a.candidates, key=lambda c: -abs(c.t))],
         "model": model_info,
