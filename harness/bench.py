@@ -130,7 +130,7 @@ def _nonlinear_oe_data(seed: int = 1):
     import numpy as np
 
     from estimators.dynamic_models import ManeuverData, load_model_file, simulate
-    model = load_model_file(Path(__file__).resolve().parents[1] / "examples" / "hfb320_model.py")
+    model = load_model_file(Path(__file__).resolve().parents[1] / "estimators" / "model_files" / "hfb320_model.py")
     c = dict(model.constants)
     qS = 0.5 * c["rho"] * 100.0 ** 2 * c["S"]
     thrust = 0.05 * qS / np.cos(0.05)

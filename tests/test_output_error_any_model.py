@@ -23,7 +23,7 @@ from harness.recording_io import write_recording
 from tests.test_output_error import SHORT_PERIOD, SP_NOISE, TRIM, perturbed, short_period_recording
 
 ROOT = Path(__file__).resolve().parents[1]
-HFB = load_model_file(ROOT / "examples" / "hfb320_model.py")
+HFB = load_model_file(ROOT / "estimators" / "model_files" / "hfb320_model.py")
 C = dict(HFB.constants)
 V0, A0, DE0 = 100.0, 0.05, -0.05
 QS = 0.5 * C["rho"] * V0 ** 2 * C["S"]

@@ -1,7 +1,7 @@
 """A nonlinear longitudinal model in the classic HFB-320 form (Jategaonkar, *Flight Vehicle
 System Identification*, ch. 4), written as an sidbench model file.
 
-    sidbench estimate --recording REC.csv --method oe --model-file examples/hfb320_model.py
+    sidbench estimate --recording REC.csv --method oe --model-file estimators/model_files/hfb320_model.py
 
 A model file is Python code that sidbench runs as it is: load only files you trust.
 
