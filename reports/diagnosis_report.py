@@ -344,8 +344,10 @@ def findings_table(findings: Sequence[Mapping]) -> Table:
              "explanation": _scalar(f.get("explanation"))}
             for f in findings]
     return Table("Findings", pd.DataFrame(rows),
-                 "Most significant first. std_error is the estimate's standard error, t = estimate / "
-                 "std_error from the selecting test. 'on validation': what the term, at its estimated size, does "
+                 "Most significant first, one row per finding with its parameter; estimate and std_error are in "
+                 "the units column. t is the selecting test's statistic: for a coefficient error, (estimate − the "
+                 "model's value over the maneuver) / std_error; for other terms, estimate / std_error (a spectral "
+                 "peak: −log10 p; turbulence: the gust-to-noise ratio). 'on validation': what the term, at its estimated size, does "
                  "to the validation maneuver's coefficient mismatch (confirmed: drops by 1 % or more; "
                  "contradicted: grows, and the term is left out of the augmented model).")
 
@@ -361,7 +363,7 @@ def evidence_table(findings: Sequence[Mapping]) -> Table | None:
 
 def candidates_table(candidates: Sequence[Mapping]) -> Table:
     """Every candidate by descending |t|, the selected ones highlighted."""
-    columns = ["effect", "axis", "channel", "parameter", "estimate", "std_error", "t",
+    columns = ["effect", "axis", "channel", "parameter", "estimate", "std_error", "units", "t",
                "explained_fraction", "selected", "reason"]
     frame = pd.DataFrame([{c: _scalar(cand.get(c)) for c in columns} for cand in candidates],
                          columns=columns)
@@ -464,6 +466,28 @@ def summary_lines(data: Mapping) -> list[str]:
     if isinstance(summary, str) and summary:
         lines.append(summary)
     return lines
+
+
+def scope_section(data: Mapping) -> Section | None:
+    """What the diagnosis assumed and what this recording could not test (findings.json's
+    ``assumptions`` and ``not_checked``), shown right after the verdict."""
+    assumed = [a for a in data.get("assumptions") or [] if isinstance(a, Mapping)]
+    unchecked = [n for n in data.get("not_checked") or [] if isinstance(n, Mapping)]
+    if not assumed and not unchecked:
+        return None
+    tables = []
+    if assumed:
+        tables.append(Table("Assumptions", pd.DataFrame(
+            [{"what": a.get("item", ""), "missing": a.get("missing", ""), "assumed instead": a.get("stood_in_by", "")}
+             for a in assumed]), "Where the recording is silent, what stood in. A finding may depend on these."))
+    if unchecked:
+        tables.append(Table("Not checked", pd.DataFrame(
+            [{"effect": n.get("effect", ""), "parameters": ", ".join(map(str, n.get("parameters") or [])) or "—",
+              "why": n.get("reason", "")} for n in unchecked]),
+            "Effects (or their parameters) this recording cannot test: 'none' does not rule them out."))
+    return Section("Assumptions and what was not checked",
+                   ("The verdict holds under these assumptions and only for what the maneuver could show.",),
+                   tuple(tables))
 
 
 def verdict_section(data: Mapping) -> Section:
@@ -615,7 +639,9 @@ def before_after_section(data: Mapping, series: Mapping[str, pd.DataFrame], mane
 def diagnosis_sections(diag: DiagnosisOutput) -> list[Section]:
     """The report's sections, in order."""
     data, series = diag.data, diag.series
-    sections = [verdict_section(data), located_section(data, series), candidates_section(data),
+    scope = scope_section(data)
+    sections = [verdict_section(data)] + ([scope] if scope is not None else []) + [
+                located_section(data, series), candidates_section(data),
                 model_section(data, diag.path), before_after_section(data, series, "identification")]
     if has_validation(data, series):
         sections.append(before_after_section(data, series, "validation"))
@@ -669,7 +695,7 @@ def diagnosis_report(out_dir: Path) -> Report:
     diag = read_diagnosis(out_dir)
     return Report(title=_title(diag.data), kind=KIND, provenance=_provenance(diag),
                   summary=tuple(summary_lines(diag.data)), sections=tuple(diagnosis_sections(diag)),
-                  numbers=_numbers(diag))
+                  numbers=_numbers(diag), status="findings" if _real(_findings(diag.data)) else "ok")
 
 
 def write_diagnosis_report(out_dir: Path) -> Path:

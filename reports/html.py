@@ -64,6 +64,7 @@ code, .mono { font-family: ui-monospace, SFMono-Regular, Menlo, Consolas, "Liber
 }
 .badge-ok { background: var(--ok-bg); }
 .badge-fail { background: var(--fail-bg); }
+.badge-findings { background: var(--warn-bg); color: var(--warn-fg); }
 .provenance {
   display: grid; grid-template-columns: max-content 1fr; gap: .15rem 1rem; margin: 0 0 1rem;
   padding: .7rem 1rem; background: var(--zebra); border-radius: 6px; font-size: .9rem;

@@ -58,8 +58,8 @@ def markdown_text(report: Report, *, html_name: str | None = None,
     -------
     str
     """
-    status = "OK" if report.status == "ok" else "FAIL"
-    icon = "✅" if report.status == "ok" else "❌"
+    status = {"ok": "OK", "findings": "FINDINGS"}.get(report.status, "FAIL")
+    icon = {"ok": "✅", "findings": "⚠️"}.get(report.status, "❌")
     lines = [f"# {_md(report.title)}", "",
              f"**Status: {icon} {status}** · {_md(report.kind)} report", ""]
     provenance = _provenance_lines(report)

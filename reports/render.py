@@ -36,7 +36,7 @@ __all__ = [
 
 KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis")
 """The kinds of report the project writes."""
-STATUSES: tuple[str, ...] = ("ok", "fail")
+STATUSES: tuple[str, ...] = ("ok", "fail", "findings")
 """Report outcomes (the nightly gate's verdict; ``ok`` for reports without a gate)."""
 HIGHLIGHT_CLASSES: tuple[str, ...] = ("bad", "good", "warn")
 """CSS classes a highlighted table cell may carry."""
@@ -186,7 +186,8 @@ class Report:
     numbers : Mapping
         Every number shown, for machines (written whole to the JSON report).
     status : str, optional
-        ``'ok'`` (default) or ``'fail'``: the nightly gate's outcome.
+        ``'ok'`` (default), ``'fail'`` (the nightly gate's outcome) or ``'findings'`` (a
+        diagnosis that found effects: not a failure, not "OK" either).
 
     Notes
     -----

@@ -83,7 +83,8 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
     geo = p.meta["geometry"]
     reg = regressors(p)
     a = reg["alpha"]
-    units_rate = "per rad (rates normalised by c/2V or b/2V)"
+    units_of = {"qhat": "per rad (q normalised by c/2V)", "phat": "per rad (p normalised by b/2V)",
+                "rhat": "per rad (r normalised by b/2V)"}
     own = ("alpha", "qhat", "de") if axis in LON else ("beta", "phat", "rhat", "da", "dr")
     values = dict(derivatives)
     if model is not None:
@@ -91,7 +92,7 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
     terms = []
     for r in own:
         if r in reg:
-            terms.append(Term(r, "coefficient_error", f"{axis}_{r}", units_rate, reg[r],
+            terms.append(Term(r, "coefficient_error", f"{axis}_{r}", units_of.get(r, "per rad"), reg[r],
                               details={"model_value": values.get(f"{axis}_{r}", float("nan")),
                                        "trim_value": derivatives.get(f"{axis}_{r}", float("nan"))},
                               sources=(REGRESSOR_SOURCE[r],)))

@@ -288,9 +288,11 @@ def _located(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> d
                     "structured_rms": structured, "structured_ratio": structured / a.noise[c],
                     "pse": fit_b["coefficients"][c]["pse"]}
     # the axis whose mismatch most follows the maneuver (the raw ratio ranks coloured noise
-    # too: accelerometer noise makes the force axes look worst on a flight with no error)
-    worst_axis = max(coefs, key=lambda c: coefs[c]["structured_ratio"])
-    worst_out = max(outs, key=lambda c: outs[c]["ratio"]) if outs else None
+    # too: accelerometer noise makes the force axes look worst on a flight with no error),
+    # among the axes the maneuver excited (a pitch maneuver's lateral mismatch is noise)
+    ranked_axes, ranked_outs = _excited_axes(p, coefs), _excited_outputs(p, outs)
+    worst_axis = max(ranked_axes, key=lambda c: coefs[c]["structured_ratio"])
+    worst_out = max(ranked_outs, key=lambda c: outs[c]["ratio"]) if ranked_outs else None
     axis = focus if focus in coefs else worst_axis
     r = np.zeros(p.n)
     r[_inner(p)] = structured_part(p, a.mismatch[axis])
@@ -302,7 +304,7 @@ def _located(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> d
     f = np.fft.rfftfreq(r.size, p.dt)
     cum = np.cumsum(spec) / max(spec.sum(), 1e-300)
     band = [float(f[int(np.searchsorted(cum, 0.1))]), float(f[min(int(np.searchsorted(cum, 0.9)), f.size - 1)])]
-    ranked = sorted(coefs, key=lambda c: -coefs[c]["structured_ratio"])[:3]
+    ranked = sorted(ranked_axes, key=lambda c: -coefs[c]["structured_ratio"])[:3]
     where = (f"the findings put it in {axis}" if focus in coefs else f"it is largest in {axis}")
     summary = ("Coefficient mismatch that follows the maneuver, in noise levels: "
                + ", ".join(f"{c} {coefs[c]['structured_ratio']:.1f}" for c in ranked)
@@ -314,6 +316,24 @@ def _located(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> d
     return {"outputs": {name: outs}, "coefficients": {name: coefs}, "worst_output": worst_out, "worst_axis": worst_axis,
             "focus_axis": axis, "time_window_s": [float(p.t[i]), float(p.t[min(i + w, p.n - 1)])], "band_hz": band,
             "summary": summary}
+
+
+_LON_OUTPUTS = ("alpha", "q", "theta", "V", "ax", "az")
+_LAT_OUTPUTS = ("beta", "p", "r", "phi", "ay")
+
+
+def _excited_axes(p: Prepared, names) -> list[str]:
+    """The coefficient axes whose group the maneuver drove (all of them when none was)."""
+    lon, lat = "de" in p.driven, any(s in p.driven for s in ("da", "dr"))
+    keep = [c for c in names if (c in cand.LON and lon) or (c in cand.LAT and lat)]
+    return keep or list(names)
+
+
+def _excited_outputs(p: Prepared, names) -> list[str]:
+    """The output channels whose group the maneuver drove (all of them when none was)."""
+    lon, lat = "de" in p.driven, any(s in p.driven for s in ("da", "dr"))
+    keep = [c for c in names if (c in _LON_OUTPUTS and lon) or (c in _LAT_OUTPUTS and lat)]
+    return keep or list(names)
 
 
 def _remaining(a: Analysis, fit_b: dict, fit_a: dict) -> dict:
@@ -363,8 +383,10 @@ def _none_finding(a: Analysis, fits_b: dict) -> dict:
                                           "explained_fraction": c.explained_fraction, "reason": c.reason} for c in top],
                 "entry_t": cand.T_IN, "mismatch_to_noise": ratios},
             "fit_before": fits_b, "fit_after": fits_b,
-            "explanation": "No candidate effect is significant against the noise the data themselves show: the "
-                           "mismatch is explained by measurement noise alone."}
+            "explanation": "No candidate effect is both significant against the noise the data themselves show "
+                           f"and large enough to matter (at least {100 * cand.PRACTICAL_SHARE:.0f} % of its "
+                           "coefficient's excursion): the mismatch is explained by measurement noise alone, within "
+                           "what this maneuver could test (see not_checked)."}
 
 
 # The factor by which the model's lift along the recorded states may differ from the
@@ -561,7 +583,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     located = _located(a, fb_id, "identification", _focus_axis(findings))
     located["remaining"] = _remaining(a, fb_id, fa_id)
     if findings:
-        worst = max(located["remaining"], key=lambda c: located["remaining"][c]["ratio"])
+        worst = max(_excited_axes(a.prepared, located["remaining"]), key=lambda c: located["remaining"][c]["ratio"])
         w = located["remaining"][worst]
         removed = f"{100 * w['removed']:.0f} % of it removed" if w["removed"] >= 0.005 else "none of it removed"
         if w["ratio"] >= UNEXPLAINED_RATIO:
