@@ -7,8 +7,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, corrected_channels, is_practical,
-                                          kinematic_check, kinematic_residuals)
+from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
+                                          is_plausible, is_practical, kinematic_check, kinematic_residuals)
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
 from models.aircraft import Aircraft
@@ -81,7 +81,14 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
     # 1. sensors: kinematic consistency says what the instruments did
     kin = kinematic_check(p)
-    sensor_values = {} if turbulent else {n: kin.selection.params[n] for n in kin.forced + kin.selection.names}
+    V0 = float(np.mean(p.smooth["V"]))
+    plausible = all(is_plausible(n, kin.selection.params[n], V0) for n in kin.forced + kin.selection.names)
+    # an implausible estimate means the kinematics disagree for another reason: then no
+    # sensor correction is applied at all (they were estimated together)
+    # and only estimates the data support (|t| >= APPLY_T) correct the channels: a nuisance bias
+    # "below the entry t" may be a poorly determined 0.7 deg, and applying it would move the model
+    sensor_values = {} if turbulent or not plausible else {
+        n: kin.selection.params[n] for n in kin.forced + kin.selection.names if _t_of(kin, n) >= APPLY_T}
     cands: list[Candidate] = []
     # the forced biases are tested one by one, not picked as the best of many: the
     # aerodynamic entry t serves, with the practical-size and precision rules
@@ -90,23 +97,24 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         sp = kin.parameters[name]
         est, se = kin.selection.params[name], kin.selection.std_errors[name]
         t = est / se if se > 0 else 0.0
-        practical = is_practical(name, est, p.dt)
+        practical = is_practical(name, est, p.dt) and _kin_share(kin, name, est, p) >= cand.PRACTICAL_SHARE
         precise = se <= max(0.5 * _practical_size(name, p.dt), 0.25 * abs(est))
-        sel = abs(t) >= t_kin and practical and precise and not turbulent
+        sel = abs(t) >= t_kin and practical and precise and not turbulent and plausible
         reason = ("significant, practical and precise" if sel else "below the entry t" if abs(t) < t_kin else
                   "within the instrument noise budget (practical size)" if not practical else
-                  "poorly determined" if not precise else NOT_IN_TURBULENCE)
+                  "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else IMPLAUSIBLE)
         cands.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
                                "kinematic consistency (bias always fitted)", sel, reason))
     for term in kin.selection.terms:
         sp = kin.parameters[term.name]
-        practical = is_practical(term.name, term.estimate, p.dt)
+        practical = (is_practical(term.name, term.estimate, p.dt)
+                     and _kin_share(kin, term.name, term.estimate, p) >= cand.PRACTICAL_SHARE)
         precise = term.std_error <= max(0.5 * _practical_size(term.name, p.dt), 0.25 * abs(term.estimate))
-        sel = term.selected and practical and precise and not turbulent
+        sel = term.selected and practical and precise and not turbulent and plausible
         reason = ("significant, practical and precise" if sel else
                   "below the entry t" if not term.selected else
                   "within the instrument noise budget (practical size)" if not practical else
-                  "poorly determined" if not precise else NOT_IN_TURBULENCE)
+                  "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else IMPLAUSIBLE)
         cands.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
                                sp.units, "kinematic consistency", sel, reason))
     # correct the channels for everything the kinematics found (noise-budget biases too)
@@ -130,9 +138,10 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # airspeed and altitude are slow: their own optimal smoothing (a far lower cut-off than the
     # common filter's) keeps their noise out of the model's coefficients (through q̂ = qc̄/2V,
     # dynamic pressure and Mach-scheduled terms)
-    for k in ("V", "h"):
-        if k in p.smooth and k in p.own_noise:
-            states[k] = p.raw[k] - p.own_noise[k]
+    if "V" in p.own_noise:
+        states["V"] = p.raw["V"] - p.own_noise["V"]
+    if p.altitude is not None:
+        states["h"] = p.altitude
     aero = aero_along(aircraft, ic, states, surfaces, p.deriv["alpha"] if "alpha" in p.driven else None)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
     mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
@@ -141,14 +150,19 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     off = cand.accelerometer_offset(p, mismatch, noise)
     x, sx = off.position_ft[0], off.std_error_ft[0]
     t_best = max(abs(v) for v in off.t)
-    off_sel = t_best >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"] and off.gain >= cand.MIN_GAIN / 2
+    cols = cand.accelerometer_columns(p)
+    inner_k = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
+    off_share = max(cand.contribution_share(sum(off.position_ft[i] * cols[a][c] for i, a in enumerate("xyz"))[inner_k],
+                                            1.0, measured[c][inner_k]) for c in ("CX", "CY", "CZ"))
+    off_sel = (t_best >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"] and off.gain >= cand.MIN_GAIN / 2
+               and off_share >= cand.PRACTICAL_SHARE)
     cands.append(Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
                            x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", off_sel,
-                           "significant and practical" if off_sel else "not significant or under 1.5 ft",
+                           "significant and practical" if off_sel else
+                           "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion",
                            {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
                             "t_xyz": list(off.t)}))
     if off_sel:
-        cols = cand.accelerometer_columns(p)
         for i, a in enumerate("xyz"):
             for c in ("CX", "CY", "CZ"):
                 mismatch[c] = mismatch[c] - off.position_ft[i] * cols[a][c]
@@ -210,6 +224,27 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
     return float(given) if given is not None else float(model_trim_thrust_lbf)
 
 
+# The |t| a kinematic estimate needs before it corrects the channels the model is evaluated on.
+APPLY_T = 3.0
+
+
+def _kin_share(kin: KinematicResult, name: str, value: float, p: Prepared) -> float:
+    """The change a sensor parameter makes to its channel, as a share of the channel's
+    excursion (:func:`kinematics.channel_share`): practical significance, as for the
+    aerodynamic terms (a noise-free flight asks for a 2 ft β-vane offset at t = 69, a
+    0.01 deg change in β)."""
+    clean = {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in p.raw}
+    k = max(1, int(round(1.0 / p.dt)))
+    return channel_share(kin.parameters[name], value, clean, p, slice(k, p.n - k))
+
+
+def _t_of(kin: KinematicResult, name: str) -> float:
+    se = kin.selection.std_errors.get(name, 0.0)
+    return abs(kin.selection.params[name] / se) if se > 0 else 0.0
+
+
+IMPLAUSIBLE = ("not applied: the kinematic fit asks for a sensor error larger than any instrument plausibly has "
+               "(kinematics.PLAUSIBLE), so the channels disagree for another reason")
 NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX cannot be told from the "
                    "thrust's own change with airspeed")
 GUST_RATIO = 4.0     # the integrated kinematic residual over what sensor noise alone gives

@@ -201,6 +201,48 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
                            residual_rms={e: float(np.sqrt(np.mean(e0[e][inner] ** 2))) for e in eqs}, start=stack)
 
 
+# The largest error an instrument of each kind plausibly has (a vane 5 deg off, a gyro 5 deg/s,
+# an accelerometer 0.2 g, an airspeed 15 % of its value, a scale factor 50 %, a skew 0.5 s, a
+# sensor 30 ft from the c.g.): a kinematic fit that asks for more is not seeing a sensor
+# error but some other inconsistency (unmodelled vane noise, a missing channel), and its
+# estimate is neither named nor used to correct the channels.
+PLAUSIBLE = {"bias": {"alpha": 5.0 * DEG, "beta": 5.0 * DEG, "V": 0.15, "p": 5.0 * DEG, "q": 5.0 * DEG,
+                      "r": 5.0 * DEG, "phi": 5.0 * DEG, "theta": 5.0 * DEG, "ax": 0.2, "ay": 0.2, "az": 0.2},
+             "scale": 0.5, "skew_s": 0.5, "offset_ft": 30.0}
+
+
+def is_plausible(name: str, value: float, V_fps: float) -> bool:
+    """Whether a sensor parameter's size could be an instrument error (:data:`PLAUSIBLE`;
+    an airspeed bias is judged against the airspeed ``V_fps``)."""
+    kind, _, channel = name.partition("_")
+    if kind == "bias":
+        limit = PLAUSIBLE["bias"].get(channel, np.inf)
+        return abs(value) <= (limit * V_fps if channel == "V" else limit)
+    if kind == "scale":
+        return abs(value) <= PLAUSIBLE["scale"]
+    if kind == "skew":
+        return abs(value) <= PLAUSIBLE["skew_s"]
+    return abs(value) <= PLAUSIBLE["offset_ft"]
+
+
+def channel_share(sp: SensorParameter, value: float, clean: dict[str, np.ndarray], p: Prepared,
+                  inner: slice) -> float:
+    """A sensor parameter's practical size: the RMS change its correction makes to the
+    channels it acts on (a bias counts whole), over the RMS excursion of the channel about its
+    mean; the largest over the channels changed (an accelerometer offset: a_x, a_y, a_z)."""
+    corrected = sp.correct(clean, p, value)
+    shares = []
+    for c, x in corrected.items():
+        if c not in clean or x is clean[c]:
+            continue
+        change = (x - clean[c])[inner]
+        excursion = float(np.std(clean[c][inner]))
+        rms = float(np.sqrt(np.mean(change ** 2)))
+        if rms > 0:
+            shares.append(rms / excursion if excursion > 0 else np.inf)
+    return max(shares, default=0.0)
+
+
 def is_practical(name: str, value: float, dt: float) -> bool:
     """Whether a sensor parameter is large enough to name (:data:`PRACTICAL`)."""
     kind, _, channel = name.partition("_")

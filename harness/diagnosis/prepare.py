@@ -69,6 +69,7 @@ class Prepared:
     mass: dict[str, np.ndarray] = field(default_factory=dict)
     driven: tuple[str, ...] = ()
     assumptions: tuple[dict, ...] = ()  # what stood in for missing channels or metadata
+    altitude: np.ndarray | None = None  # ft: the h channel (own smoothing), or its stand-in
 
     @property
     def n(self) -> int:
@@ -137,20 +138,22 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     measured = measured_coefficients(smooth, deriv, rec.meta, mass)
     driven = maneuver_driven(smooth, noise, w, excited)
     own_noise = {c: np.asarray(f.noise) for c, f in fits.items()}
-    if "h" not in raw:
-        # pressure altitude from the density that q̄ and V imply (ISA, standard day)
+    if "h" in raw:
+        altitude = raw["h"] - own_noise["h"]
+    else:
+        # pressure altitude from the density that q̄ and V (each by its own optimal smoothing)
+        # imply, ISA standard day; kept out of ``raw``: the kinematic checks must not see a
+        # made-up ḣ
         rho = 2.0 * (raw["qbar"] - own_noise["qbar"]) / (raw["V"] - own_noise["V"]) ** 2
-        h = density_altitude_ft(np.clip(rho, 1e-6, None))
-        raw["h"], smooth["h"], deriv["h"] = h, sine_series_filter(h, w), sine_series_derivative(h, w, dt)
-        own_noise["h"] = np.zeros_like(h)
-        start["h"] = float(np.mean(smooth["h"][:k]))
+        altitude = density_altitude_ft(np.clip(rho, 1e-6, None))
         assumptions.append({"item": "altitude", "missing": "h channel",
-                            "stood_in_by": f"the ISA altitude of the density 2 q̄ / V² ({start['h']:.0f} ft at the "
-                                           "start; a standard day assumed)"})
+                            "stood_in_by": f"the ISA altitude of the density 2 q̄ / V² ({np.mean(altitude[:k]):.0f} ft "
+                                           "at the start; a standard day assumed)"})
     return Prepared(name=name, t=t, dt=dt, raw=raw, smooth=smooth, deriv=deriv, noise_std=noise,
                     cutoff_hz={c: f.cutoff_hz for c, f in fits.items()}, weights=w, common_cutoff_hz=cutoff,
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
-                    own_noise=own_noise, mass=mass, driven=driven, assumptions=tuple(assumptions))
+                    own_noise=own_noise, mass=mass, driven=driven, assumptions=tuple(assumptions),
+                    altitude=altitude)
 
 
 def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...]) -> list[dict]:

@@ -186,7 +186,9 @@ def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
     """The initial condition with the found sensor errors of V, α and h undone (recorded =
     x + b, (1 + k)·x): the augmented model must start where the aircraft was, not where
     its instruments said it was."""
-    ch = {c: p.smooth[c].copy() for c in ("V", "alpha", "h") if c in p.smooth}
+    ch = {c: p.smooth[c].copy() for c in ("V", "alpha") if c in p.smooth}
+    if p.altitude is not None:
+        ch["h"] = p.altitude.copy()
     for e in added:
         if e.channel in ch and e.effect == "sensor_bias":
             ch[e.channel] = ch[e.channel] - e.size
@@ -560,7 +562,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     elif mass != "model":
         raise DiagnosisError(f"mass must be 'model' or 'recording', not {mass!r}")
     p = prepare(rec, "identification")
-    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.smooth.get("h"))
+    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude)
     a = analyse(p, aircraft, ic)
     check_model_represents(a, model)
     findings = _findings(a)
@@ -568,7 +570,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     av = None
     if validation is not None:
         pv = prepare(read_recording(validation), "validation")
-        av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.smooth.get("h")))
+        av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.altitude))
         checks = {id(f): validation_check(av, f) for f in findings}
         # a finding the validation maneuver contradicts is reported but not modelled
         findings = sorted(findings, key=lambda f: (checks[id(f)] or {}).get("status") == "contradicted")
