@@ -40,6 +40,8 @@ from estimators.result import ModelFit, collinearity
 from estimators.state_space import discretize, discretize_derivatives, propagate, scan
 from maneuvers.recording import Recording
 
+RHO_CAP = 0.999  # largest spectral radius of the predictor F = Φ − KC a step aims at
+
 
 def _predictor(Phi, Gam, C, D, K, u1, z):
     """One-step predictions x̂ (N, n) and innovations ν (N, n_o) of (FE-1), x̂_0 = 0."""
@@ -98,7 +100,7 @@ class FilterError:
             Phi, Gam, _ = discretize(A, B, dt)
             x, nu, F = _predictor(Phi, Gam, C, D, K, u1, z)
             if not sens:
-                return nu, F, None
+                return nu, F, None, None
             dPhi, dGam, _ = discretize_derivatives(A, B, dA, dB, dt)
             dF = np.concatenate([dPhi - K @ dC, -eye @ C])
             dG = np.concatenate([dGam - K @ dD, -eye @ D])
@@ -110,7 +112,16 @@ class FilterError:
             dC_all = np.concatenate([dC, np.zeros((n * no, no, n))])
             dD_all = np.concatenate([dD, np.zeros((n * no, no, u1.shape[1]))])
             dnu = -(dx @ C.T + np.einsum("pij,kj->pki", dC_all, x) + np.einsum("pij,kj->pki", dD_all, u1))
-            return nu, F, dnu
+            return nu, F, dnu, dF
+
+        def radius_gradient(F, dF):
+            """Spectral radius of F and its gradient over the parameters (first-order eigenvalue
+            perturbation of the dominant eigenvalue: dλ = wᴴ dF v / wᴴ v)."""
+            lam, V = np.linalg.eig(F)
+            i = int(np.argmax(np.abs(lam)))
+            W = np.linalg.inv(V)  # rows: left eigenvectors, scaled so that wᴴ v = 1
+            dlam = np.einsum("i,pij,j->p", W[i], dF, V[:, i])
+            return float(abs(lam[i])), np.real(np.conj(lam[i]) * dlam) / abs(lam[i])
 
         def stable(F):
             return bool(np.max(np.abs(np.linalg.eigvals(F))) < 1.0)
@@ -124,22 +135,36 @@ class FilterError:
             W = (dnu @ L).reshape(len(dnu), -1)
             return W @ W.T, -W @ (nu @ L).ravel()
 
-        nu, F, dnu = evaluate(theta)
+        nu, F, dnu, dF = evaluate(theta)
         S = nu.T @ nu / len(nu)
-        J, history, converged, it = cost(nu, S), [], False, 0
+        J, history, converged, it, constrained = cost(nu, S), [], False, 0, False
         history.append(J)
         for it in range(1, self.max_iterations + 1):
             M, grad = information(dnu, nu, S)
             d = _check_information(M, names)
-            step = np.linalg.solve(M / np.outer(d, d), grad / d) / d  # grad = −Σ ∂νᵀS⁻¹ν
-            se = np.sqrt(np.diag(_inverse(M, d)))
+            Minv = _inverse(M, d)
+            step = Minv @ grad  # grad = −Σ ∂νᵀS⁻¹ν
+            se = np.sqrt(np.diag(Minv))
+            # The likelihood of a finite record often keeps falling as the predictor's slowest
+            # mode crosses the unit circle (the spectral factor's zero sits close to z = 1 when
+            # an output combination carries little low-frequency noise): an unconstrained step
+            # would leave the stable region, and halving it only creeps up to the boundary. The
+            # step is then the Gauss-Newton step constrained to keep ρ(F) at RHO_CAP to first
+            # order (an active set: min ½ΔᵀMΔ − gᵀΔ subject to ∇ρᵀΔ = RHO_CAP − ρ).
+            rho, g_rho = radius_gradient(F, dF)
+            constrained = bool(rho + g_rho @ step > RHO_CAP)
+            if constrained:
+                c = min(0.0, RHO_CAP - rho)
+                Mg = Minv @ g_rho
+                step = step - Mg * ((g_rho @ step - c) / (g_rho @ Mg))
             L = np.linalg.cholesky(np.linalg.inv(S))
             quad = 0.5 * float(np.sum((nu @ L) ** 2))
             lam, ok = 1.0, False
             for _ in range(12):
                 trial = theta + lam * step
-                nu_t, F_t, _ = evaluate(trial, sens=False)
-                if stable(F_t) and np.all(np.isfinite(nu_t)) and 0.5 * np.sum((nu_t @ L) ** 2) <= quad:
+                nu_t, F_t, _, _ = evaluate(trial, sens=False)
+                if stable(F_t) and np.all(np.isfinite(nu_t)) and (
+                        0.5 * np.sum((nu_t @ L) ** 2) <= quad or (constrained and rho > RHO_CAP and lam == 1.0)):
                     ok = True
                     break
                 lam /= 2
@@ -152,7 +177,7 @@ class FilterError:
                 raise DivergenceError(f"filter error diverged at iteration {it}: no step reduces the cost "
                                       f"(step {np.max(np.abs(step) / se):.3g} standard errors)")
             theta = trial
-            nu, F, dnu = evaluate(theta)
+            nu, F, dnu, dF = evaluate(theta)
             S_new = nu.T @ nu / len(nu)
             J_new = cost(nu, S_new)
             history.append(J_new)
@@ -174,7 +199,8 @@ class FilterError:
               for i, o in enumerate(spec.outputs)}
         info = {"S": S.tolist(), "cost": J, "cost_history": history, "iterations": it, "converged": converged,
                 "r2": r2, "outputs": list(spec.outputs), "model": spec.name, "flight": data.flight.as_dict(),
-                "oe_cost": oe.info["cost"], "notes": list(data.notes)}
+                "oe_cost": oe.info["cost"], "notes": list(data.notes),
+                "spectral_radius": float(np.max(np.abs(np.linalg.eigvals(F)))), "stability_constrained": constrained}
         L = np.linalg.cholesky(np.linalg.inv(S))
         return ModelFit(method=self.method, domain="time", dependent=",".join(spec.outputs), names=names,
                         params=theta, cov=cov, residuals=nu, fitted=z - nu, n=len(z),

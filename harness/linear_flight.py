@@ -9,6 +9,17 @@ and held per sample, as a digital flight computer would. The recording carries �
 accelerations, so the coefficients of Eqs. 1-5 equal the linear models' exactly (with the
 rates normalised by the constant trim airspeed V_o, as in Eq. 34), and output error faces the
 model it assumes.
+
+**Turbulence** (process noise, ``turbulence=``): JSBSim's MIL-spec ("Dryden") vertical gust w_g,
+with its own scales — σ_w and L_w from MIL-F-8785C as JSBSim's ``FGWinds`` takes them (the
+probability-of-exceedance table, Fig. 7, above 2,000 ft; 0.1·W₂₀ and L_w = h below 1,000 ft) and
+its first-order form ẇ_g = −(2V/L_w) w_g + σ_w √(4V/L_w) n(t) (JSBSim's eq. 32, stationary
+variance σ_w²) — enters as an angle-of-attack disturbance α_g = w_g/V (w_g positive down): the
+aerodynamic forces and moments, the vane and the accelerometer see α = α_i − α_g, the kinematics
+the inertial α_i. The augmented system (α_i, q, α_g) is sampled exactly (matrix exponential for
+the held inputs, Van Loan's integral for the noise), from zero gust at t = 0 as JSBSim starts.
+JSBSim's pitch-rate gust q_g (∝ ẇ_g/b) and the lateral gusts are not modelled: the lateral model
+flies in still air.
 """
 from __future__ import annotations
 
@@ -17,7 +28,7 @@ import dataclasses
 import numpy as np
 import pandas as pd
 
-from estimators.state_space import (discretize, lateral_matrices, propagate, short_period_dimensional,
+from estimators.state_space import (discretize, expm_small, lateral_matrices, propagate, short_period_dimensional,
                                     short_period_matrices, simulate_linear)
 from harness.campaign import FlightKey
 from maneuvers.recording import G0_FPS2, Recording
@@ -26,9 +37,70 @@ LATERAL = ("CY", "Cl", "Cn")
 LAT_VARS = ("beta", "phat", "rhat", "da", "dr")
 
 
-def linear_flight(key: FlightKey, fly_nominal) -> Recording:
+# MIL-F-8785C Fig. 7 as JSBSim's FGWinds tabulates it: σ_w (ft/s) by probability-of-exceedance
+# index (JSBSim's severity, 1..7) at these altitudes (ft), interpolated linearly, clamped at the ends.
+POE_ALTITUDES_FT = (500.0, 1750.0, 3750.0, 7500.0, 15000.0, 25000.0, 35000.0, 45000.0, 55000.0, 65000.0,
+                    75000.0, 80000.0)
+POE_SIGMA_FPS = {
+    1: (3.2, 2.2, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    2: (4.2, 3.6, 3.3, 1.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    3: (6.6, 6.9, 7.4, 6.7, 4.6, 2.7, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0),
+    4: (8.6, 9.6, 10.6, 10.1, 8.0, 6.6, 5.0, 4.2, 2.7, 0.0, 0.0, 0.0),
+    5: (11.8, 13.0, 16.0, 15.1, 11.6, 9.7, 8.1, 8.2, 7.9, 4.9, 3.2, 2.1),
+    6: (15.6, 17.6, 23.0, 23.6, 22.1, 20.0, 16.0, 15.1, 12.1, 7.9, 6.2, 5.1),
+    7: (18.7, 21.5, 28.4, 30.2, 30.7, 31.0, 25.2, 23.1, 17.5, 10.7, 8.4, 7.2),
+}
+
+
+def vertical_gust_scales(turbulence, h_ft: float) -> tuple[float, float]:
+    """σ_w (ft/s) and L_w (ft) of JSBSim's MIL-spec turbulence at altitude ``h_ft``."""
+    if turbulence.severity == 0:
+        return 0.0, 1750.0
+    h = max(float(h_ft), 10.0)
+    table = float(np.interp(h, POE_ALTITUDES_FT, POE_SIGMA_FPS[turbulence.severity]))
+    low = 0.1 * turbulence.wind_20ft_fps
+    if h <= 1000.0:
+        return low, h
+    if h <= 2000.0:
+        return low + (h - 1000.0) / 1000.0 * (table - low), 1000.0 + (h - 1000.0) / 1000.0 * 750.0
+    return table, 1750.0
+
+
+def _noise_covariance(A: np.ndarray, Qc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Φ = e^{A dt} and Q_d = ∫₀^dt e^{As} Q_c e^{Aᵀs} ds (Van Loan, 1978)."""
+    n = len(A)
+    M = np.zeros((2 * n, 2 * n))
+    M[:n, :n], M[:n, n:], M[n:, n:] = -A, Qc, A.T
+    E = expm_small(M * dt)
+    Phi = E[n:, n:].T
+    Qd = Phi @ E[:n, n:]
+    return Phi, (Qd + Qd.T) / 2
+
+
+def gust_short_period(dim: dict, V: float, dt: float, de_cmd: np.ndarray, K: float, sigma_w: float,
+                      L_w: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """α (aerodynamic), q and α_g of the short period flown through the vertical gust (module
+    docstring), the pitch-rate loop sampled and held per sample."""
+    tau = L_w / (2.0 * V)  # JSBSim's eq. 32: xi_w = (1 − 2T/τ_w) xi_w + …, τ_w = L_w/V
+    Za, Ma = dim["Z_alpha"], dim["M_alpha"]
+    A = np.array([[Za, 1.0 + dim["Z_q"], -Za], [Ma, dim["M_q"], -Ma], [0.0, 0.0, -1.0 / tau]])
+    B = np.array([[dim["Z_de"]], [dim["M_de"]], [0.0]])
+    Phi, G0, _ = discretize(A, B, dt)
+    Qc = np.zeros((3, 3))
+    Qc[2, 2] = (sigma_w / V) ** 2 * 2.0 / tau  # stationary variance (σ_w/V)²
+    _, Qd = _noise_covariance(A, Qc, dt)
+    lam, U = np.linalg.eigh(Qd)
+    root = U * np.sqrt(np.clip(lam, 0.0, None))
+    w = rng.standard_normal((len(de_cmd) - 1, 3)) @ root.T
+    F = np.array([[0.0, K, 0.0]])
+    x = propagate(Phi + G0 @ F, de_cmd[:-1, None] @ G0.T + w, np.zeros(3))
+    return x[:, 0] - x[:, 2], x[:, 1], x[:, 2]
+
+
+def linear_flight(key: FlightKey, fly_nominal, turbulence=None, turbulence_seed: int = 0) -> Recording:
     """Simulate the linear models for ``key`` (``fly_nominal(key)`` gives the JSBSim flight
-    whose trim, truth and inputs they use)."""
+    whose trim, truth and inputs they use), in still air or through ``turbulence``'s vertical
+    gust (seeded by ``turbulence_seed``; module docstring)."""
     nominal = fly_nominal(dataclasses.replace(key, variant="nominal", loop="open"))
     meta = dict(nominal.meta)
     trim, truth = meta["trim"], {k: v["local"] for k, v in meta["truth"]["derivatives"].items()}
@@ -44,15 +116,24 @@ def linear_flight(key: FlightKey, fly_nominal) -> Recording:
     dim = short_period_dimensional(truth["CZ_alpha"], truth["CZ_qhat"], truth["CZ_de"], truth["Cm_alpha"],
                                    truth["Cm_qhat"], truth["Cm_de"], qbar, S, c, m["mass_slug"], m["Iy_slugft2"], V)
     A, B, C, D = short_period_matrices(**dim, V_o=V)
-    # δs,k = δs,cmd,k + K q_k, held over each sample interval (a digital loop, as in the
-    # JSBSim flights): x_{k+1} = (Φ + Γ F) x_k + Γ δs,cmd,k.
-    Phi, G0, _ = discretize(A, B, dt)
-    F = np.array([[0.0, K]])
-    x = propagate(Phi + G0 @ F, de_cmd[:-1, None] @ G0.T, np.zeros(2))
-    alpha, q = x[:, 0], x[:, 1]
+    if turbulence is not None and turbulence.kind != "dryden":
+        raise ValueError(f"the linear-model flight flies the MIL-spec Dryden vertical gust only, not "
+                         f"{turbulence.kind!r} turbulence")
+    sigma_w, L_w = vertical_gust_scales(turbulence, trim["h_ft"]) if turbulence is not None else (0.0, 0.0)
+    gust = None
+    if sigma_w > 0:
+        alpha, q, gust = gust_short_period(dim, V, dt, de_cmd, K, sigma_w, L_w,
+                                           np.random.default_rng(int(turbulence_seed)))
+    else:
+        # δs,k = δs,cmd,k + K q_k, held over each sample interval (a digital loop, as in the
+        # JSBSim flights): x_{k+1} = (Φ + Γ F) x_k + Γ δs,cmd,k.
+        Phi, G0, _ = discretize(A, B, dt)
+        F = np.array([[0.0, K]])
+        x = propagate(Phi + G0 @ F, de_cmd[:-1, None] @ G0.T, np.zeros(2))
+        alpha, q = x[:, 0], x[:, 1]
     de = de_cmd + K * q
     qdot = dim["M_alpha"] * alpha + dim["M_q"] * q + dim["M_de"] * de
-    alphadot = dim["Z_alpha"] * alpha + (1 + dim["Z_q"]) * q + dim["Z_de"] * de
+    alphadot = dim["Z_alpha"] * alpha + (1 + dim["Z_q"]) * q + dim["Z_de"] * de  # inertial (w/V) in a gust
     qhat = q * c / (2 * V)
     dCZ = truth["CZ_alpha"] * alpha + truth["CZ_qhat"] * qhat + truth["CZ_de"] * de
     dCm = truth["Cm_alpha"] * alpha + truth["Cm_qhat"] * qhat + truth["Cm_de"] * de
@@ -93,6 +174,8 @@ def linear_flight(key: FlightKey, fly_nominal) -> Recording:
         "truth_CL_1": -CZ * np.cos(alpha_abs) + CX * np.sin(alpha_abs),
         "truth_alphadot_rps": alphadot,
     }
+    if gust is not None:
+        data["truth_alpha_gust_rad"] = gust
     # Only these derivatives are the linear models' own; their local and fit values coincide.
     own = {f"{co}_{v}" for co in ("CZ", "Cm") for v in ("alpha", "qhat", "de")} | set(lat)
     meta["truth"] = dict(meta["truth"])
@@ -100,6 +183,11 @@ def linear_flight(key: FlightKey, fly_nominal) -> Recording:
                                     for k, v in meta["truth"]["derivatives"].items() if k in own}
     meta["simulation"] = dict(meta["simulation"]) | {
         "variant": "linear", "loop": {"kind": "closed" if K else "open", "pitch_rate_gain": K},
+        "turbulence": None if turbulence is None else {
+            "kind": turbulence.kind, "severity": turbulence.severity, "wind_20ft_fps": turbulence.wind_20ft_fps,
+            "seed": int(turbulence_seed), "sigma_w_fps": sigma_w, "L_w_ft": L_w,
+            "model": "MIL-spec vertical gust as JSBSim flies it (first order, time constant L_w/2V), "
+                     "entering as alpha_g = w_g/V; no pitch-rate or lateral gusts"},
         "linear_model": "seed Eq. 33 short period (Eq. 34 dimensional derivatives) and the linear "
                         "lateral-directional model, from the nominal aircraft's local truth derivatives; "
                         "rates normalised by the trim airspeed"}

@@ -20,7 +20,7 @@ from harness.executors import make_executor
 from harness.progress import Progress
 from harness.scores import score
 from harness.store import append_history, git_commit, versions, write_parquet, write_run
-from harness.tasks import prefly, run_task
+from harness.tasks import preflown, prefly, run_task
 
 DEFAULT_CACHE = Path(".sidbench-cache")
 
@@ -120,7 +120,7 @@ def _run_locked(campaign: Campaign, out_dir: Path, *, scheduler: str | None, wor
     t0 = time.perf_counter()
     compute = 0.0
     with make_executor(scheduler, workers) as ex:
-        keys = sorted({f for t in pending if t.noise.turbulence is None for f in t.flights}, key=lambda k: k.digest())
+        keys = sorted({f for t in pending for f in preflown(t)}, key=lambda k: k.digest())
         missing = [k for k in keys if not (Path(cache) / "flights" / f"{k.digest()}.parquet").is_file()]
         bar = Progress(len(missing) + len(pending), f"{campaign.name}", enabled=progress)
         for _, seconds in ex.imap_unordered(prefly, missing, cache):

@@ -25,11 +25,9 @@ ROW_COLUMNS = ["task_id", "campaign", "flight", "aircraft", "variant", "conditio
 
 def fly_key(key: FlightKey, turbulence=None, turbulence_seed: int = 0) -> Recording:
     """Fly the flight ``key`` describes (variant ``'linear'``: the seed's linear models)."""
-    if key.variant == "linear":
-        if turbulence is not None:
-            raise ValueError("the linear-model flight has no turbulence model")
+    if key.variant == "linear":  # turbulence: its own MIL-spec vertical gust (harness.linear_flight)
         from harness.linear_flight import linear_flight
-        return linear_flight(key, fly_key)
+        return linear_flight(key, fly_key, turbulence, turbulence_seed)
     from harness.flying import parse_loop
     from maneuvers.fly import FlightSpec, fly_maneuver
     from models.aircraft import Aircraft
@@ -174,7 +172,11 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
     turb = task.noise.turbulence
     if turb is not None:
         turb_seed = int(stream(task.seed, "turbulence").integers(1, 2**31 - 1))
-        clean = fly_key(task.flight, turb, turb_seed)
+        if task.flight.variant == "linear":  # the still-air JSBSim flight it is built on, cached
+            from harness.linear_flight import linear_flight
+            clean = linear_flight(task.flight, lambda k: cached_flight(k, cache_dir), turb, turb_seed)
+        else:
+            clean = fly_key(task.flight, turb, turb_seed)
     else:
         clean = cached_flight(task.flight, cache_dir)
     noisy = apply_noise(clean, noise_model, task.seed) if (noise_model.channels or noise_model.drop) else clean
@@ -216,6 +218,17 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
         rows += crb_rows(common, clean, noise_model, equations)
         rows += excursion_rows(common, clean)
     return pd.DataFrame(rows, columns=ROW_COLUMNS), time.perf_counter() - t_start
+
+
+def preflown(task: Task) -> tuple[FlightKey, ...]:
+    """The clean flights a task reads from the cache: its own, or, when turbulence is flown per
+    realization, the still-air nominal flight a linear-model flight is built on (none for
+    JSBSim's own turbulent flights)."""
+    if task.noise.turbulence is None:
+        return task.flights
+    import dataclasses
+    return tuple(dataclasses.replace(f, variant="nominal", loop="open") for f in task.flights
+                 if f.variant == "linear")
 
 
 def prefly(key: FlightKey, cache_dir: str) -> float:
