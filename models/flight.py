@@ -105,7 +105,7 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         deflections: Deflections, duration_s: float, *, sample_rate_hz: float = 50.0,
         sim_rate_hz: float = 120.0, loop: Loop = Loop(),
         alpha_limit_rad: float = math.radians(40.0), turbulence: Turbulence | None = None,
-        turbulence_seed: int = 0) -> FlightHistory:
+        turbulence_seed: int = 0, wind_ned_fps: Mapping[str, np.ndarray] | None = None) -> FlightHistory:
     """Fly a trimmed instance with the surfaces driven directly and record it.
 
     Parameters
@@ -121,6 +121,10 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         ``N = round(duration_s * sample_rate_hz) + 1``.
     turbulence, turbulence_seed : Turbulence or None, int
         Process noise flown from the first frame on (the trim is calm).
+    wind_ned_fps : mapping or None
+        A given wind history (``north``, ``east``, ``down``, ft/s, on the recorded sample
+        times ``k / sample_rate_hz``; linearly interpolated onto the frames and written to
+        ``atmosphere/wind-*-fps`` before each frame): a recorded flight's reconstructed gusts.
 
     Raises
     ------
@@ -164,6 +168,14 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         setter(float(values[0]))
         for f in (np.flatnonzero(np.diff(values)) + 1).tolist():
             changes.setdefault(f, []).append((setter, float(values[f])))
+    if wind_ned_fps:
+        t_samples = np.arange(n_samples) / sample_rate_hz
+        for axis, series in wind_ned_fps.items():
+            values = np.interp(t_frames, t_samples[:len(series)], np.asarray(series, dtype=float)[:n_samples])
+            setter = node(f"atmosphere/wind-{axis}-fps").set_double_value
+            setter(float(values[0]))
+            for f in range(1, n_frames + 1):
+                changes.setdefault(f, []).append((setter, float(values[f])))
     for e in delays:
         # the aerodynamics see the surface late: drive its delay property with δ(t − τ) − δ(t)
         values = trim_pos[e.surface] + commands.get(e.surface, np.zeros(n_frames + 1))

@@ -52,9 +52,11 @@ def trim_at(aircraft: Aircraft, ic: InitialCondition, refs: Mapping[str, float] 
 
 
 def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Mapping[str, np.ndarray], *,
-           refs: Mapping[str, float] | None = None, sim_rate_hz: float = 120.0) -> tuple[FlightHistory, TrimPoint]:
+           refs: Mapping[str, float] | None = None, sim_rate_hz: float = 120.0,
+           wind_ned_fps: Mapping[str, np.ndarray] | None = None) -> tuple[FlightHistory, TrimPoint]:
     """Fly ``aircraft`` from trim at ``ic`` with the recording's surface motions.
 
+    ``wind_ned_fps`` flies it through a given wind history (:func:`models.flight.fly`).
     Each surface moves by the recorded change from its first sample (linear interpolation
     between samples onto the simulation frames), about the model's own trim position: a
     model that needs another trim deflection still starts in equilibrium.
@@ -75,7 +77,8 @@ def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Ma
         return {s: np.interp(tf, rel, x) for s, x in moves.items()}
 
     dt = float(np.median(np.diff(t)))
-    hist = fly(fdm, aircraft, tp, deflections, rel[-1], sample_rate_hz=1.0 / dt, sim_rate_hz=sim_rate_hz)
+    hist = fly(fdm, aircraft, tp, deflections, rel[-1], sample_rate_hz=1.0 / dt, sim_rate_hz=sim_rate_hz,
+               wind_ned_fps=wind_ned_fps)
     return hist, tp
 
 

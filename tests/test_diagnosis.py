@@ -261,3 +261,21 @@ def test_sweep_runs_and_resumes(tmp_path):
     assert (tmp_path / "sweep.md").read_text().count("| none_s2 |") == 1
     with pytest.raises(ValueError, match="no sweep case"):
         sweep(tmp_path, ["gremlin"])
+
+
+def test_gallery_turbulence_is_modelled_by_flying_through_the_reconstructed_gusts(gallery):
+    """The augmented replay flies through the gusts the kinematics reconstruct: the lateral
+    outputs of the validation maneuver (which the identification never saw) fit far better."""
+    f = gallery["turbulence"]["findings"][0]
+    before, after = f["fit_before"]["validation"]["outputs"], f["fit_after"]["validation"]["outputs"]
+    for ch in ("beta", "p", "r"):
+        assert after[ch]["rms"] < 0.7 * before[ch]["rms"], (ch, before[ch]["rms"], after[ch]["rms"])
+
+
+def test_gallery_structural_mode_is_modelled_as_a_notch(gallery):
+    f = gallery["structural_mode"]["findings"][0]
+    before, after = f["fit_before"]["validation"]["outputs"], f["fit_after"]["validation"]["outputs"]
+    assert after["q"]["rms_raw"] < 0.8 * before["q"]["rms_raw"]
+    assert after["az"]["rms_raw"] < before["az"]["rms_raw"]
+    sensors = gallery["structural_mode"]["model"]["terms"]  # aircraft terms: none for a mode
+    assert not [t for t in sensors if t.get("effect") == "structural_mode"]

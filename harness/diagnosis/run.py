@@ -10,12 +10,14 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy import signal
 
 from harness.atomic import write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason
+from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
 from harness.recording_io import read_recording
 from models.aircraft import MODELS, Aircraft, is_xml_model, nominal_root
 from models.hidden import HiddenEffect, hidden_root
@@ -209,9 +211,11 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
     except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
         before_failed = str(exc)
     after_hist, diverged = before_hist, before_failed
-    if added and before_failed is None:
+    winds = _turbulence_winds(p, analysis) if any(f.effect == "turbulence" for f in findings or []) else None
+    if (added or winds is not None) and before_failed is None:
         try:
-            after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), _true_start(p, added), p.t, surfaces)
+            after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), _true_start(p, added), p.t, surfaces,
+                                   wind_ned_fps=winds)
         except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient fits still stand
             after_hist, diverged = None, str(exc)
     a = analysis
@@ -223,7 +227,8 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
     sim_a = _sim_channels(after_hist) if after_hist is not None else nan
     fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner) if before_failed is None else {},
              "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
-    fit_a = {"outputs": output_fit(p.smooth, p.raw, sim_a, OUTPUTS, inner) if diverged is None else {},
+    raw_after = _mode_notched(p, findings or [])
+    fit_a = {"outputs": output_fit(p.smooth, raw_after, sim_a, OUTPUTS, inner) if diverged is None else {},
              "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
     if before_failed is not None:
         fit_b["replay_failed"] = f"the model could not replay this maneuver: {before_failed}"
@@ -245,6 +250,42 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
         if s in p.raw:
             series[s] = p.raw[s]
     return a, fit_b, fit_a, pd.DataFrame(series)
+
+
+# Quality factor of the sensor model's notch for a structural mode (bandwidth f0/Q): wide
+# enough for the mode's frequency uncertainty (a 2 s Welch segment resolves 0.5 Hz).
+MODE_NOTCH_Q = 8.0
+
+
+def _mode_notched(p: Prepared, findings: list[Candidate]) -> dict[str, np.ndarray]:
+    """The recorded channels as the augmented sensor model sees them: a structural mode found
+    becomes a notch (scipy.signal.iirnotch at its frequency, zero phase) in every rate and
+    acceleration channel, so the raw fit after shows what the mode term removes. Returns
+    ``p.raw`` unchanged when no mode was found."""
+    modes = [f for f in findings if f.effect == "structural_mode"]
+    if not modes:
+        return p.raw
+    out = dict(p.raw)
+    fs = 1.0 / p.dt
+    for f in modes:
+        if not 0.0 < f.estimate < 0.5 * fs:
+            continue
+        b, a = signal.iirnotch(f.estimate, MODE_NOTCH_Q, fs=fs)
+        for c in MODE_CHANNELS:
+            if c in out:
+                out[c] = signal.filtfilt(b, a, out[c])
+    return out
+
+
+def _turbulence_winds(p: Prepared, a: Analysis) -> dict[str, np.ndarray] | None:
+    """The gusts this maneuver met, as a north-east-down wind for the replay: the body-axis
+    gust histories the kinematic residuals give (:func:`spectra.gust_estimate`) rotated by
+    the recorded attitude. A deterministic stand-in for a process-noise model: the augmented
+    replay flies through the turbulence each maneuver's own kinematics reconstruct."""
+    if a.gust is None or getattr(a.gust, "w_fps", None) is None:
+        return None
+    psi = p.smooth.get("psi", np.zeros(p.n))
+    return gust_wind_ned(a.gust, p.smooth["phi"], p.smooth["theta"], psi)
 
 
 def structured_part(p: Prepared, mismatch: np.ndarray) -> np.ndarray:
@@ -601,7 +642,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         series["validation"] = series_v
         located["outputs"]["validation"] = _located(av, fb_v, "validation")["outputs"]["validation"]
     timing["total"] = time.perf_counter() - t0
-    model_info = _write_model(out, aircraft, ic, added)
+    model_info = _write_model(out, aircraft, ic, added, _sensor_models(modelled))
     result = {
         "findings": [_finding_dict(f, fits_b, fits_a, checks.get(id(f))) for f in findings]
         or [_none_finding(a, fits_b)],
@@ -624,13 +665,31 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     return result
 
 
-def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ...]) -> dict:
-    """Copy the augmented aircraft (XML) into ``out/model``; sensor effects are listed in
-    ``sensors.json`` beside it (they change what the instruments record, not the flight)."""
+def _sensor_models(findings: list[Candidate]) -> list[dict]:
+    """Findings that become sensor- or atmosphere-side models rather than aircraft terms: a
+    structural mode's notch and the turbulence's reconstructed gusts."""
+    out = []
+    for f in findings:
+        if f.effect == "structural_mode":
+            out.append({"effect": "structural_mode", "frequency_hz": float(f.estimate), "notch_q": MODE_NOTCH_Q,
+                        "channels": [c for c in MODE_CHANNELS], "model": "second-order notch (scipy.signal.iirnotch), "
+                        "zero phase, on the rate and acceleration channels"})
+        if f.effect == "turbulence":
+            out.append({"effect": "turbulence", "sigma_gust_fps": float(f.estimate),
+                        "model": "the replay flies through the gusts each maneuver's kinematic residuals reconstruct "
+                                 "(u, v, w integrated and high-passed at 0.05 Hz, rotated to north-east-down)"})
+    return out
+
+
+def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ...],
+                 other: list[dict] | None = None) -> dict:
+    """Copy the augmented aircraft (XML) into ``out/model``; sensor effects (and a structural
+    mode's notch, the turbulence model) are listed in ``sensors.json`` beside it (they change
+    what the instruments record, or the air the aircraft flies through, not the aircraft)."""
     dest = out / "model"
     dest.mkdir(parents=True, exist_ok=True)
     terms = [e.describe() | {"parameter": e.parameter} for e in added]
-    sensors = [t for t, e in zip(terms, added) if e.effect.startswith("sensor_")]
+    sensors = [t for t, e in zip(terms, added) if e.effect.startswith("sensor_")] + list(other or [])
     write_text_atomic(dest / "sensors.json", json.dumps(sensors, indent=1))
     if not any(not e.effect.startswith("sensor_") for e in added):
         return {"base": aircraft.model, "augmented_xml": None, "terms": terms,

@@ -103,6 +103,9 @@ class GustEstimate:
     sigma_w_fps: float
     sigma_v_fps: float
     ratio_to_noise: float
+    w_fps: np.ndarray | None = None  # the body-axis gust histories (air-mass velocity, z, y, x)
+    v_fps: np.ndarray | None = None
+    u_fps: np.ndarray | None = None
 
 
 def gust_estimate(kin_residuals: dict[str, np.ndarray], p: Prepared, noise_accel_fps2: float) -> GustEstimate:
@@ -112,10 +115,11 @@ def gust_estimate(kin_residuals: dict[str, np.ndarray], p: Prepared, noise_accel
     b, a = signal.butter(2, 0.05, btype="highpass", fs=1.0 / p.dt)
     k = max(1, int(round(1.0 / p.dt)))
 
-    def sigma(e: np.ndarray) -> float:
-        g = signal.filtfilt(b, a, np.cumsum(e) * p.dt)
-        return float(np.std(g[k:-k]))
-    sw, sv = sigma(kin_residuals["w"]), sigma(kin_residuals.get("v", np.zeros(p.n)))
+    def gust(e: np.ndarray) -> np.ndarray:
+        # E = d(air-relative)/dt - d(inertial)/dt = -d(air-mass velocity)/dt, body axes
+        return -signal.filtfilt(b, a, np.cumsum(e) * p.dt)
+    gw, gv = gust(kin_residuals["w"]), gust(kin_residuals.get("v", np.zeros(p.n)))
+    sw, sv = float(np.std(gw[k:-k])), float(np.std(gv[k:-k]))
     # what white sensor noise alone gives: the operator (integrate, high-pass) is nearly
     # time-invariant, so the variance it passes is σ² times the energy of its response to
     # one impulse (mid-record, away from the ends) -- no random draw needed
@@ -123,4 +127,18 @@ def gust_estimate(kin_residuals: dict[str, np.ndarray], p: Prepared, noise_accel
     impulse[p.n // 2] = 1.0
     response = signal.filtfilt(b, a, np.cumsum(impulse) * p.dt)
     floor = noise_accel_fps2 * float(np.sqrt(np.sum(response ** 2)))
-    return GustEstimate(sw, sv, max(sw, sv) / max(floor, 1e-12))
+    gu = gust(kin_residuals["u"]) if "u" in kin_residuals else None
+    return GustEstimate(sw, sv, max(sw, sv) / max(floor, 1e-12), gw, gv, gu)
+
+
+def gust_wind_ned(gust: GustEstimate, phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> dict[str, np.ndarray]:
+    """The estimated body-axis gust (u, v, w) as a wind in north-east-down axes (ft/s), for
+    replaying the flight through the turbulence it met: C_nb = (R_z(ψ) R_y(θ) R_x(φ))."""
+    u = gust.u_fps if gust.u_fps is not None else np.zeros_like(phi)
+    v = gust.v_fps if gust.v_fps is not None else np.zeros_like(phi)
+    w = gust.w_fps if gust.w_fps is not None else np.zeros_like(phi)
+    cf, sf, ct, st, cp, sp = np.cos(phi), np.sin(phi), np.cos(theta), np.sin(theta), np.cos(psi), np.sin(psi)
+    north = u * (ct * cp) + v * (cp * st * sf - sp * cf) + w * (cp * st * cf + sp * sf)
+    east = u * (ct * sp) + v * (sp * st * sf + cp * cf) + w * (sp * st * cf - cp * sf)
+    down = -u * st + v * (ct * sf) + w * (ct * cf)
+    return {"north": north, "east": east, "down": down}
