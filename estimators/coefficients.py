@@ -43,7 +43,8 @@ def wind_axis_coefficients(CX, CZ, alpha) -> dict[str, np.ndarray]:
 
 
 def moment_coefficients(p, q, r, pdot, qdot, rdot, qbar_psf, S_ft2, b_ft, cbar_ft,
-                        Ix, Iy, Iz, Ixz, thrust_lbf=0.0, thrust_offset_ft=0.0) -> dict[str, np.ndarray]:
+                        Ix, Iy, Iz, Ixz, thrust_lbf=0.0, thrust_offset_ft=0.0,
+                        which=("Cl", "Cm", "Cn")) -> dict[str, np.ndarray]:
     """Seed Eqs. 3-5, with the thrust line's pitching moment removed from Cm.
 
     Cl = Ix/(q̄Sb) [ṗ − Ixz/Ix (pq + ṙ) + (Iz − Iy)/Ix qr]
@@ -52,14 +53,19 @@ def moment_coefficients(p, q, r, pdot, qdot, rdot, qbar_psf, S_ft2, b_ft, cbar_f
 
     ``Ixz`` has the seed's sign (positive 982 slug·ft² in its F-16 Table 1); ``thrust_offset_ft``
     is the thrust line's body-z position (positive below the c.g.), so the thrust moment is
-    +T·z_T.
+    +T·z_T. ``which`` names the coefficients wanted (the others, and the angular accelerations
+    only they use, may be ``None``).
     """
     qS = np.asarray(qbar_psf) * S_ft2
-    Cl = Ix / (qS * b_ft) * (pdot - Ixz / Ix * (p * q + rdot) + (Iz - Iy) / Ix * q * r)
-    Cm = (Iy / (qS * cbar_ft) * (qdot + (Ix - Iz) / Iy * p * r + Ixz / Iy * (p**2 - r**2))
-          - np.asarray(thrust_lbf) * thrust_offset_ft / (qS * cbar_ft))
-    Cn = Iz / (qS * b_ft) * (rdot - Ixz / Iz * (pdot - q * r) + (Iy - Ix) / Iz * p * q)
-    return {"Cl": Cl, "Cm": Cm, "Cn": Cn}
+    out = {}
+    if "Cl" in which:
+        out["Cl"] = Ix / (qS * b_ft) * (pdot - Ixz / Ix * (p * q + rdot) + (Iz - Iy) / Ix * q * r)
+    if "Cm" in which:
+        out["Cm"] = (Iy / (qS * cbar_ft) * (qdot + (Ix - Iz) / Iy * p * r + Ixz / Iy * (p**2 - r**2))
+                     - np.asarray(thrust_lbf) * thrust_offset_ft / (qS * cbar_ft))
+    if "Cn" in which:
+        out["Cn"] = Iz / (qS * b_ft) * (rdot - Ixz / Iz * (pdot - q * r) + (Iy - Ix) / Iz * p * q)
+    return out
 
 
 Differentiator = Callable[[np.ndarray, float], np.ndarray]
@@ -104,7 +110,11 @@ def thrust_assumption(rec: Recording, coefficient: str) -> tuple[str, ...]:
             "term absorbs (exactly when q̄ is constant)",)
 
 
-def coefficients_from_recording(rec: Recording, differentiate: Differentiator | None = None) -> pd.DataFrame:
+ALL_COEFFICIENTS = ("CX", "CY", "CZ", "CD", "CL", "Cl", "Cm", "Cn")
+
+
+def coefficients_from_recording(rec: Recording, differentiate: Differentiator | None = None,
+                                names: tuple[str, ...] | list[str] | None = None) -> pd.DataFrame:
     """CX, CY, CZ, CL, CD, Cl, Cm, Cn from a recording's channels (Eqs. 1-5).
 
     Parameters
@@ -116,24 +126,60 @@ def coefficients_from_recording(rec: Recording, differentiate: Differentiator | 
     differentiate : callable or None
         ``(x, dt) -> dx/dt`` used for the angular accelerations. ``None`` uses the recorded
         ``pdot``, ``qdot``, ``rdot`` channels (refused, naming them, if absent).
+    names : the coefficients wanted (all eight when None), in the frame's column order.
     """
-    p, q, r = rec.channel("p"), rec.channel("q"), rec.channel("r")
-    if differentiate is None:
-        pdot, qdot, rdot = rec.channel("pdot"), rec.channel("qdot"), rec.channel("rdot")
-    else:
-        pdot, qdot, rdot = (differentiate(x, rec.dt) for x in (p, q, r))
-    g, m = rec.geometry, rec.mass_at()
+    wanted = ALL_COEFFICIENTS if names is None else tuple(names)
+    return pd.DataFrame(_coefficients(rec, differentiate, wanted), columns=list(wanted))
+
+
+def coefficient_from_recording(rec: Recording, name: str, differentiate: Differentiator | None = None) -> np.ndarray:
+    """One of the coefficients of :func:`coefficients_from_recording`, computed alone: only the
+    channels (and angular accelerations) its equation uses, no frame. Bit-identical to the frame's
+    column."""
+    return _coefficients(rec, differentiate, (name,))[name]
+
+
+def _coefficients(rec: Recording, differentiate: Differentiator | None,
+                  names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    unknown = [n for n in names if n not in ALL_COEFFICIENTS]
+    if unknown:
+        raise ValueError(f"unknown coefficient(s) {unknown}: use {ALL_COEFFICIENTS}")
+    rates: dict[str, np.ndarray] = {}
+
+    def rate(name: str) -> np.ndarray:  # p, q, r and (recorded or differentiated) pdot, qdot, rdot
+        if name not in rates:
+            if len(name) == 1 or differentiate is None:
+                rates[name] = rec.channel(name)
+            else:
+                rates[name] = differentiate(rate(name[0]), rec.dt)
+        return rates[name]
+
+    g = rec.geometry
+    # constant mass properties stay scalars (the same arithmetic as broadcast arrays, less memory)
+    m = rec.mass_at(0) if rec.mass_is_constant else rec.mass_at()
     thrust, _ = thrust_source(rec)
-    r_acc = rec.meta.get("sensors", {}).get("accelerometer_ft", [0.0, 0.0, 0.0])
-    ax, ay, az = accelerometer_at_cg(rec.channel("ax"), rec.channel("ay"), rec.channel("az"),
-                                     p, q, r, pdot, qdot, rdot, r_acc)
     qbar = rec.channel("qbar")
-    out = force_coefficients(ax, ay, az, thrust, qbar, m["mass_slug"], g["S_ft2"])
-    out.update(wind_axis_coefficients(out["CX"], out["CZ"], rec.channel("alpha")))
-    out.update(moment_coefficients(p, q, r, pdot, qdot, rdot, qbar, g["S_ft2"], g["b_ft"], g["cbar_ft"],
-                                   m["Ix_slugft2"], m["Iy_slugft2"], m["Iz_slugft2"], m["Ixz_slugft2"],
-                                   thrust, float(rec.meta.get("thrust_offset_ft", 0.0))))
-    return pd.DataFrame(out)
+    out: dict[str, np.ndarray] = {}
+    if any(n in ("CX", "CY", "CZ", "CD", "CL") for n in names):
+        r_acc = rec.meta.get("sensors", {}).get("accelerometer_ft", [0.0, 0.0, 0.0])
+        if any(float(v) != 0.0 for v in r_acc):
+            ax, ay, az = accelerometer_at_cg(rec.channel("ax"), rec.channel("ay"), rec.channel("az"),
+                                             *(rate(k) for k in ("p", "q", "r", "pdot", "qdot", "rdot")), r_acc)
+        else:
+            ax, ay, az = rec.channel("ax"), rec.channel("ay"), rec.channel("az")
+        forces = force_coefficients(ax, ay, az, thrust, qbar, m["mass_slug"], g["S_ft2"])
+        out.update(forces)
+        if any(n in ("CD", "CL") for n in names):
+            out.update(wind_axis_coefficients(forces["CX"], forces["CZ"], rec.channel("alpha")))
+    moments = [n for n in ("Cl", "Cm", "Cn") if n in names]
+    if moments:
+        need = {"Cl": ("pdot", "rdot"), "Cm": ("qdot",), "Cn": ("rdot", "pdot")}
+        acc = {k: rate(k) for n in moments for k in need[n]}
+        out.update(moment_coefficients(rate("p"), rate("q"), rate("r"), acc.get("pdot"), acc.get("qdot"),
+                                       acc.get("rdot"), qbar, g["S_ft2"], g["b_ft"], g["cbar_ft"],
+                                       m["Ix_slugft2"], m["Iy_slugft2"], m["Iz_slugft2"], m["Ixz_slugft2"],
+                                       thrust, float(rec.meta.get("thrust_offset_ft", 0.0)), which=moments))
+    return {n: out[n] for n in names}
 
 
 def normalized_rates(rec: Recording, V_ref: float | None = None) -> dict[str, np.ndarray]:

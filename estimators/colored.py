@@ -16,12 +16,20 @@ with the residual autocorrelation estimate of Eq. 39,
 ``R(k) = 0`` for ``|k| > r``.
 
 The middle matrix is ``X^T T X`` with ``T`` the N-by-N symmetric Toeplitz
-matrix ``T[i, j] = R(|i - j|)``.  ``T`` is never formed: ``T X`` is computed
-column by column either by ``2 r + 1`` shifted additions (O(N r n_p), used
-for few lags) or as an FFT convolution of each column with the two-sided
-kernel ``[R(r), ..., R(1), R(0), R(1), ..., R(r)]`` (O(n_p N log N), used
-for many lags, including the default of all ``N - 1`` lags).  Only time-domain
-(real) data are handled.
+matrix ``T[i, j] = R(|i - j|)``.  ``T`` is never formed, nor ``T X``: with the
+thin QR factor ``Q`` of ``X``, ``Q^T T Q`` is accumulated one column ``T q_b``
+at a time, either by ``2 r + 1`` shifted additions (O(N r n_p), used for few
+lags) or as a circular FFT convolution of the zero-padded column with the
+two-sided kernel ``[R(0), R(1), ..., R(r), 0, ..., 0, R(r), ..., R(1)]`` of a
+fast length ``L >= N + r`` (O(n_p N log N), used for many lags, including the
+default of all ``N - 1`` lags), long enough that no wrapped-around term reaches
+the first ``N`` outputs, so the product is the linear one of Eq. 40.  With all
+lags the kernel's spectrum is ``|rfft(v, L)|**2 / N`` itself (Eq. 39 by the
+Wiener-Khinchin relation), so ``R`` is never transformed back and forth.
+Memory is the one copy of ``X`` that is factorised in place (none when its QR
+factor is passed in) plus about five float64 vectors of length N at the peak,
+whatever ``n_p`` (a 10 M-sample, 4-regressor problem takes some 0.7 GB in all).
+Only time-domain (real) data are handled.
 
 Public API
 ----------
@@ -36,7 +44,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 from scipy import fft as sp_fft
-from scipy import linalg, signal
+from scipy import linalg
 
 __all__ = ["residual_autocorrelation", "colored_residual_covariance"]
 
@@ -49,7 +57,7 @@ def _as_real_vector(v: npt.ArrayLike, name: str) -> np.ndarray:
     a = np.asarray(v)
     if np.iscomplexobj(a):
         raise ValueError(f"{name} must be real (time-domain data only)")
-    a = a.astype(float)
+    a = np.asarray(a, dtype=float)  # read only here: no copy when already float64
     if a.ndim != 1:
         raise ValueError(f"{name} must be 1-D")
     if a.size == 0:
@@ -113,22 +121,83 @@ def residual_autocorrelation(v: npt.ArrayLike, max_lag: int | None = None) -> np
     return out / n
 
 
-def _toeplitz_times(r_vals: np.ndarray, q: np.ndarray, method: str) -> np.ndarray:
-    """``T @ q`` for ``T[i, j] = r_vals[|i-j|]`` (zero beyond ``len(r_vals)-1``)."""
-    n = q.shape[0]
-    r = min(r_vals.size - 1, n - 1)
-    if method == "direct":
-        out = r_vals[0] * q
-        for k in range(1, r + 1):
-            rk = r_vals[k]
-            if rk == 0.0:
-                continue
-            out[:-k] += rk * q[k:]
-            out[k:] += rk * q[:-k]
+def _kernel_spectrum(v: np.ndarray, r: int, r_vals: np.ndarray | None, nfft: int) -> np.ndarray:
+    """Real spectrum (``rfft`` bins) of the circular kernel ``c`` of length ``nfft`` with
+    ``c[k] = c[nfft - k] = R(k)`` for ``k = 0..r`` and zero elsewhere.
+
+    With all lags (``r = N - 1``) and ``nfft >= 2N - 1``, ``c`` is the circular
+    autocorrelation of ``v`` zero-padded to ``nfft`` divided by ``N``, whose spectrum is
+    ``|rfft(v, nfft)|**2 / N`` exactly: no inverse transform is needed.  Otherwise ``c`` is
+    formed from ``r_vals`` (``R(0..r)``, needed only then) and transformed (its spectrum is
+    real as ``c`` is even; the rounding-level imaginary part is dropped).
+    """
+    n = v.size
+    if r == n - 1:
+        spec = sp_fft.rfft(v, nfft)
+        out = np.square(spec.real)
+        out += np.square(spec.imag)
+        del spec
+        out /= n
         return out
-    kernel = np.concatenate([r_vals[r:0:-1], r_vals[: r + 1]])  # length 2r+1
-    full = signal.fftconvolve(q, kernel[:, None], mode="full", axes=0)
-    return full[r : r + n]
+    c = np.zeros(nfft)
+    c[: r + 1] = r_vals
+    if r:
+        c[nfft - r:] = r_vals[r:0:-1]
+    return sp_fft.rfft(c, overwrite_x=True).real.copy()
+
+
+def _toeplitz_quadratic(q: np.ndarray, v: np.ndarray, r: int, r_vals: np.ndarray | None,
+                        method: str) -> np.ndarray:
+    """``q^T T q`` for ``T[i, j] = R(|i-j|)`` of the residuals ``v`` (zero beyond lag
+    ``r <= N - 1``; ``r_vals`` holds ``R(0..r)``, ``None`` for all lags by FFT), ``T``
+    never formed and ``T q`` formed one column at a time (memory O(N), not O(N n_p)).
+
+    ``"direct"``: ``T q_b`` by ``2 r + 1`` shifted additions.  ``"fft"``: ``T q_b`` as the
+    first ``N`` samples of the circular convolution, length ``L >= N + r`` (a fast length),
+    of ``q_b`` zero-padded with the even kernel of :func:`_kernel_spectrum`; with ``L >= N + r``
+    no wrapped-around term reaches the first ``N`` outputs, so this is the linear (Eq. 40)
+    product exactly, up to rounding.
+    """
+    n, n_p = q.shape
+    middle = np.empty((n_p, n_p))
+    if method == "direct":
+        y = np.empty(n)
+        for b in range(n_p):
+            qb = q[:, b]
+            np.multiply(r_vals[0], qb, out=y)
+            for k in range(1, r + 1):
+                rk = r_vals[k]
+                if rk == 0.0:
+                    continue
+                y[:-k] += rk * qb[k:]
+                y[k:] += rk * qb[:-k]
+            middle[:, b] = q.T @ y
+        return middle
+    nfft = sp_fft.next_fast_len(n + r, real=True)
+    spec_c = _kernel_spectrum(v, r, r_vals, nfft)
+    for b in range(n_p):
+        buf = np.zeros(nfft)
+        buf[:n] = q[:, b]
+        spec = sp_fft.rfft(buf, overwrite_x=True)
+        del buf
+        if b == n_p - 1 and b > 0:
+            # the last column's other entries are the last row's (symmetry), computed already;
+            # its diagonal q_b^T T q_b by Parseval, sum over all L bins of C |S|^2 / L (the rfft
+            # bins stand for two each except the zero frequency and, for even L, Nyquist)
+            power = np.square(spec.real)
+            power += np.square(spec.imag)
+            del spec
+            power *= spec_c
+            total = 2.0 * power.sum() - power[0] - (power[-1] if nfft % 2 == 0 else 0.0)
+            middle[:b, b] = middle[b, :b]
+            middle[b, b] = total / nfft
+            return middle
+        spec *= spec_c
+        y = sp_fft.irfft(spec, nfft, overwrite_x=True)
+        del spec
+        middle[:, b] = q.T @ y[:n]
+        del y
+    return middle
 
 
 def colored_residual_covariance(
@@ -137,6 +206,7 @@ def colored_residual_covariance(
     max_lag: int | None = None,
     *,
     method: Literal["auto", "direct", "fft"] = "auto",
+    factor: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Parameter covariance corrected for coloured residuals (seed Eq. 40).
 
@@ -165,6 +235,10 @@ def colored_residual_covariance(
         ``"fft"``: FFT convolution, O(n_p N log N); ``"auto"`` picks
         ``"direct"`` for ``r <= 32`` and ``"fft"`` otherwise.  All give the
         same result to rounding.
+    factor : (Q, R), optional
+        The thin QR factorisation of ``X`` (``scipy.linalg.qr(X, mode="economic")``) when the
+        caller has it already (``least_squares(..., keep_factor=True)``): it is used as given
+        instead of factorising ``X`` again.
 
     Returns
     -------
@@ -199,12 +273,14 @@ def colored_residual_covariance(
     xm = np.asarray(X)
     if np.iscomplexobj(xm):
         raise ValueError("X must be real (time-domain data only)")
-    xm = xm.astype(float)
     if xm.ndim == 1:
         xm = xm[:, None]
     if xm.ndim != 2:
         raise ValueError("X must be 2-D (N, n_p)")
-    if not np.all(np.isfinite(xm)):
+    if factor is None:
+        # one Fortran-ordered float64 copy, factorised in place below (X itself is never changed)
+        xm = np.array(xm, dtype=float, order="F")
+    if not np.isfinite(xm).all():
         raise ValueError("X contains NaN or infinite values")
     v = _as_real_vector(residuals, "residuals")
     n, n_p = xm.shape
@@ -215,17 +291,24 @@ def colored_residual_covariance(
     if method not in ("auto", "direct", "fft"):
         raise ValueError("method must be 'auto', 'direct' or 'fft'")
     r = min(_resolve_max_lag(max_lag, n), n - 1)
-    r_vals = residual_autocorrelation(v, r)
     if method == "auto":
         method = "direct" if r <= _DIRECT_MAX_LAG else "fft"
+    # with all lags the FFT route takes the kernel's spectrum straight from the residuals'
+    r_vals = None if (method == "fft" and r == n - 1) else residual_autocorrelation(v, r)
 
-    q, rr = linalg.qr(xm, mode="economic")
+    if factor is None:
+        q, rr = linalg.qr(xm, mode="economic", overwrite_a=True, check_finite=False)
+    else:
+        q, rr = (np.asarray(f, dtype=float) for f in factor)
+        if q.shape != (n, n_p) or rr.shape != (n_p, n_p):
+            raise ValueError(f"factor must be the thin QR factorisation of X: Q {n} x {n_p}, R {n_p} x {n_p}")
+    del xm
     diag = np.abs(np.diag(rr))
     if diag.min() <= np.finfo(float).eps * max(n, n_p) * diag.max():
         raise np.linalg.LinAlgError("X is rank deficient; X^T X is singular")
 
-    tq = _toeplitz_times(r_vals, q, method)
-    middle = q.T @ tq
+    middle = _toeplitz_quadratic(q, v, r, r_vals, method)
+    del q
     middle = 0.5 * (middle + middle.T)
     a = linalg.solve_triangular(rr, middle)  # R^{-1} M
     cov = linalg.solve_triangular(rr, a.T).T  # R^{-1} M R^{-T}

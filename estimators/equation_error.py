@@ -145,8 +145,9 @@ class EquationErrorTime:
             X, z = sine_series_filter(X, weights), sine_series_filter(z, weights)
             info["smoother_cutoff_hz"] = max(f.cutoff_hz for f in fits)
         A = np.column_stack([X, np.ones(len(z))]) if d.equation.bias else X
-        ls = least_squares(A, z, d.names)
-        cov_colored = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag)
+        ls = least_squares(A, z, d.names, keep_factor=True)
+        cov_colored = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag, factor=ls.factor)
+        ls = replace(ls, factor=None)  # Q is N x n_p: not kept past its use
         cov_conventional = ls.s2 * ls.xtx_inv
         cov = cov_colored if self.errors == "colored" else cov_conventional
         ratio = colored_to_conventional_se(cov_colored, cov_conventional)

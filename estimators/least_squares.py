@@ -20,6 +20,9 @@ class LeastSquares:
     residuals: np.ndarray
     fitted: np.ndarray
     s2: float
+    # (Q, R), the thin QR factorisation of the (real-stacked) regressors, when asked for
+    # (``keep_factor``): colored_residual_covariance reuses it instead of factorising again
+    factor: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def _real_stack(A: np.ndarray) -> np.ndarray:
@@ -27,14 +30,16 @@ def _real_stack(A: np.ndarray) -> np.ndarray:
     return np.concatenate([A.real, A.imag], axis=0) if np.iscomplexobj(A) else A
 
 
-def check_rank(X: np.ndarray, names: tuple[str, ...] | list[str], *, rtol: float = 1e-10) -> None:
-    """Refuse linearly dependent regressors, naming the columns of the offending combination.
-
-    Columns are scaled to unit length first, so the test does not depend on units."""
-    A = _real_stack(np.asarray(X))
+def _check_shape(A: np.ndarray, names: tuple[str, ...] | list[str]) -> None:
     if A.shape[0] < A.shape[1]:
         raise SingularRegressorsError(f"{A.shape[0]} data points cannot determine {A.shape[1]} parameters "
                                       f"({', '.join(names)})")
+
+
+def _check_scaled(A: np.ndarray, names: tuple[str, ...] | list[str], rtol: float) -> None:
+    """The zero-column and singular-value tests of :func:`check_rank` on ``A``: the regressors
+    themselves or their triangular QR factor ``R`` (same column norms, same singular values and
+    right singular vectors once the columns are scaled, since ``Q`` is orthonormal)."""
     norms = np.linalg.norm(A, axis=0)
     zero = [names[j] for j in np.flatnonzero(norms == 0)]
     if zero:
@@ -50,7 +55,17 @@ def check_rank(X: np.ndarray, names: tuple[str, ...] | list[str], *, rtol: float
             "fly a maneuver that separates them")
 
 
-def least_squares(X: np.ndarray, z: np.ndarray, names: tuple[str, ...] | list[str]) -> LeastSquares:
+def check_rank(X: np.ndarray, names: tuple[str, ...] | list[str], *, rtol: float = 1e-10) -> None:
+    """Refuse linearly dependent regressors, naming the columns of the offending combination.
+
+    Columns are scaled to unit length first, so the test does not depend on units."""
+    A = _real_stack(np.asarray(X))
+    _check_shape(A, names)
+    _check_scaled(A, names, rtol)
+
+
+def least_squares(X: np.ndarray, z: np.ndarray, names: tuple[str, ...] | list[str], *,
+                  keep_factor: bool = False) -> LeastSquares:
     """Solve z = Xθ + ν in the least-squares sense.
 
     Real data: Eqs. 14-16, θ̂ = (XᵀX)⁻¹Xᵀz, σ̂² = (z − ŷ)ᵀ(z − ŷ)/(N − n_p).
@@ -58,7 +73,8 @@ def least_squares(X: np.ndarray, z: np.ndarray, names: tuple[str, ...] | list[st
     Eq. 23, with σ̂² = (z − ŷ)†(z − ŷ)/(m − n_p) where m counts complex points (not 2m).
 
     A QR factorisation solves the problem (never the normal equations), so near-collinear
-    noise-free data are still solved to rounding error (seed §III.G).
+    noise-free data are still solved to rounding error (seed §III.G). ``keep_factor`` keeps
+    it in the result (``factor = (Q, R)``, N × n_p more memory while the result lives).
 
     Raises
     ------
@@ -67,9 +83,16 @@ def least_squares(X: np.ndarray, z: np.ndarray, names: tuple[str, ...] | list[st
     """
     X = np.asarray(X)
     z = np.asarray(z)
-    check_rank(X, names)
     A, b = _real_stack(X), _real_stack(z)
-    q, r = scipy.linalg.qr(A, mode="economic")
+    _check_shape(A, names)
+    # check_rank's test on the n_p x n_p factor R instead of the N x n_p regressors (no scaled
+    # copy and SVD of a long matrix): a zero column of A is an exactly zero column of R
+    # (Householder reflections map zero to zero), and A D^-1 = Q (R D^-1) has the singular
+    # values and right singular vectors of R D^-1.
+    # factorised in place in a Fortran-ordered copy of ours (scipy's own copy of a C-ordered
+    # array is several times slower for a long, narrow matrix)
+    q, r = scipy.linalg.qr(np.array(A, order="F"), mode="economic", overwrite_a=True)
+    _check_scaled(r, names, rtol=1e-10)
     theta = scipy.linalg.solve_triangular(r, q.T @ b)
     r_inv = scipy.linalg.solve_triangular(r, np.eye(r.shape[0]))
     xtx_inv = r_inv @ r_inv.T
@@ -77,7 +100,8 @@ def least_squares(X: np.ndarray, z: np.ndarray, names: tuple[str, ...] | list[st
     resid = z - fitted
     n, p = X.shape
     s2 = float(np.real(np.vdot(resid, resid))) / (n - p) if n > p else float("nan")
-    return LeastSquares(theta=theta, xtx_inv=xtx_inv, residuals=resid, fitted=fitted, s2=s2)
+    return LeastSquares(theta=theta, xtx_inv=xtx_inv, residuals=resid, fitted=fitted, s2=s2,
+                        factor=(q, r) if keep_factor else None)
 
 
 def r_squared(z: np.ndarray, residuals: np.ndarray) -> float:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from estimators.coefficients import coefficients_from_recording, thrust_assumption, thrust_source
+from estimators.coefficients import coefficient_from_recording, thrust_assumption, thrust_source
 from estimators.differentiation import smooth_derivative
 from maneuvers.recording import Recording, RecordingError
 
@@ -193,12 +193,13 @@ class _Builder:
         return self.cache.setdefault(name, x - self.reference(name, x))
 
     def term(self, text: str) -> np.ndarray:
-        out = np.ones(self.rec.n)
+        out = None
         for factor in text.split("*"):
             m = _TERM.match(factor.strip())
             if not m:
                 raise EquationError(f"cannot read regressor term {text!r} (use names, '*' and '^k')")
-            out = out * self.base(m.group(1)) ** int(m.group(2) or 1)
+            x = self.base(m.group(1)) ** int(m.group(2) or 1)  # a new array (1.0 * x is x exactly)
+            out = x if out is None else out * x
         return out
 
     def angular_acceleration(self, axis: str) -> np.ndarray:
@@ -228,7 +229,7 @@ class _Builder:
         if assumed and thrust_source(rec)[1] == "unknown":
             self.notes.append(f"{name} computed with zero thrust: the recording has neither a thrust channel "
                               "nor a trim thrust (see assumptions)")
-        return coefficients_from_recording(rec, diff)[name].to_numpy()
+        return coefficient_from_recording(rec, name, diff)
 
 
 def regression_data(rec: Recording, equation: Equation, options: DataOptions = DataOptions()) -> RegressionData:

@@ -34,6 +34,16 @@ def parameter_correlation(cov: np.ndarray) -> np.ndarray:
     return r
 
 
+# Above this many rows the diagnostics below work through blocks of rows (a few MB each) instead
+# of centred, scaled copies of the whole regressor matrix; below it they are computed as always.
+_BLOCK_ROWS = 1 << 16
+
+
+def _blocks(n: int):
+    for start in range(0, n, _BLOCK_ROWS):
+        yield slice(start, min(start + _BLOCK_ROWS, n))
+
+
 def variance_inflation(X: np.ndarray, is_bias: np.ndarray) -> np.ndarray:
     """VIF_j = 1/(1 − R_j²) of each non-constant column regressed on the others (centred):
     the diagonal of the inverse correlation matrix of the regressors."""
@@ -41,12 +51,24 @@ def variance_inflation(X: np.ndarray, is_bias: np.ndarray) -> np.ndarray:
     out = np.full(X.shape[1], np.nan)
     if len(cols) == 0:
         return out
-    Xr = np.real(X[:, cols]) if not np.iscomplexobj(X) else np.vstack([X[:, cols].real, X[:, cols].imag])
-    Xc = Xr - (Xr.mean(axis=0) if not np.iscomplexobj(X) else 0.0)
-    norms = np.linalg.norm(Xc, axis=0)
-    if np.any(norms == 0):
-        return out
-    Rm = (Xc / norms).T @ (Xc / norms)
+    if not np.iscomplexobj(X) and X.shape[0] > _BLOCK_ROWS:
+        # the same centred cross-products, accumulated block by block
+        mean = X[:, cols].mean(axis=0) if len(cols) == X.shape[1] else np.array([X[:, j].mean() for j in cols])
+        G = np.zeros((len(cols), len(cols)))
+        for rows in _blocks(X.shape[0]):
+            B = X[rows][:, cols] - mean
+            G += B.T @ B
+        norms = np.sqrt(np.diag(G))
+        if np.any(norms == 0):
+            return out
+        Rm = G / np.outer(norms, norms)
+    else:
+        Xr = np.real(X[:, cols]) if not np.iscomplexobj(X) else np.vstack([X[:, cols].real, X[:, cols].imag])
+        Xc = Xr - (Xr.mean(axis=0) if not np.iscomplexobj(X) else 0.0)
+        norms = np.linalg.norm(Xc, axis=0)
+        if np.any(norms == 0):
+            return out
+        Rm = (Xc / norms).T @ (Xc / norms)
     if len(cols) == 1:
         out[cols] = 1.0
         return out
@@ -57,6 +79,14 @@ def variance_inflation(X: np.ndarray, is_bias: np.ndarray) -> np.ndarray:
 def scaled_condition_number(X: np.ndarray) -> float:
     """Condition number of X with each column scaled to unit Euclidean length."""
     A = np.vstack([X.real, X.imag]) if np.iscomplexobj(X) else X
+    if A.shape[0] > _BLOCK_ROWS and A.shape[0] > A.shape[1]:
+        # cond(A D^-1) = cond(R) of its QR factor, built block by block (R of [R; next block])
+        norms = np.sqrt(sum(np.einsum("ij,ij->j", A[rows], A[rows]) for rows in _blocks(A.shape[0])))
+        norms[norms == 0] = 1.0
+        R = np.zeros((0, A.shape[1]))
+        for rows in _blocks(A.shape[0]):
+            R = np.linalg.qr(np.vstack([R, A[rows] / norms]), mode="r")
+        return float(np.linalg.cond(R))
     norms = np.linalg.norm(A, axis=0)
     norms[norms == 0] = 1.0
     return float(np.linalg.cond(A / norms))

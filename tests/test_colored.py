@@ -125,3 +125,19 @@ def test_one_dimensional_regressor():
 def test_invalid_input(X, v, kwargs, exc):
     with pytest.raises(exc):
         colored_residual_covariance(X, v, **kwargs)
+
+
+def test_given_qr_factor_gives_the_same_covariance():
+    """least_squares(..., keep_factor=True) hands its QR factor on: no second factorisation,
+    the same numbers."""
+    from estimators.least_squares import least_squares
+
+    X, v = _problem(n=3000, seed=6)
+    z = X @ np.array([0.5, -1.0, 0.2, 0.1]) + v
+    ls = least_squares(X, z, ("a", "b", "c", "bias"), keep_factor=True)
+    for max_lag in (None, 10, 500):
+        np.testing.assert_array_equal(colored_residual_covariance(X, ls.residuals, max_lag, factor=ls.factor),
+                                      colored_residual_covariance(X, ls.residuals, max_lag))
+    assert least_squares(X, z, ("a", "b", "c", "bias")).factor is None
+    with pytest.raises(ValueError, match="factor"):
+        colored_residual_covariance(X[:, :3], ls.residuals, factor=ls.factor)

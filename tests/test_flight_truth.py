@@ -174,3 +174,17 @@ def test_turbulence_is_flown_per_seed_and_reproducible():
     assert not np.array_equal(a.channel("alpha"), c.channel("alpha"))
     assert np.std(a.channel("alpha") - calm.channel("alpha")) > math.radians(0.1)
     assert a.meta["simulation"]["turbulence"]["seed"] == 1
+
+
+def test_one_coefficient_alone_is_the_frames_column(three_axis_f16):
+    """coefficient_from_recording computes one coefficient from only what its equation uses,
+    bit for bit the column of the full frame (recorded and differentiated rates)."""
+    from estimators.coefficients import coefficient_from_recording
+    from estimators.differentiation import smooth_derivative
+
+    rec = three_axis_f16
+    for diff in (None, lambda x, dt: smooth_derivative(x, dt, method=1)):
+        frame = coefficients_from_recording(rec, diff)
+        assert list(frame.columns) == ["CX", "CY", "CZ", "CD", "CL", "Cl", "Cm", "Cn"]
+        for c in frame.columns:
+            np.testing.assert_array_equal(coefficient_from_recording(rec, c, diff), frame[c].to_numpy())
