@@ -208,7 +208,10 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
 # estimate is neither named nor used to correct the channels.
 PLAUSIBLE = {"bias": {"alpha": 5.0 * DEG, "beta": 5.0 * DEG, "V": 0.15, "p": 5.0 * DEG, "q": 5.0 * DEG,
                       "r": 5.0 * DEG, "phi": 5.0 * DEG, "theta": 5.0 * DEG, "ax": 0.2, "ay": 0.2, "az": 0.2},
-             "scale": 0.5, "skew_s": 0.5, "offset_ft": 30.0}
+             "scale": {"alpha": 0.3, "beta": 0.3, "V": 0.1}, "skew_s": 0.5, "offset_ft": 30.0}
+# (vanes: upwash scale errors of tens of percent are real; a pitot-static airspeed 10 %;
+# rates and accelerations: the default below)
+PLAUSIBLE_SCALE_DEFAULT = 0.1
 
 
 def is_plausible(name: str, value: float, V_fps: float) -> bool:
@@ -219,7 +222,7 @@ def is_plausible(name: str, value: float, V_fps: float) -> bool:
         limit = PLAUSIBLE["bias"].get(channel, np.inf)
         return abs(value) <= (limit * V_fps if channel == "V" else limit)
     if kind == "scale":
-        return abs(value) <= PLAUSIBLE["scale"]
+        return abs(value) <= PLAUSIBLE["scale"].get(channel, PLAUSIBLE_SCALE_DEFAULT)
     if kind == "skew":
         return abs(value) <= PLAUSIBLE["skew_s"]
     return abs(value) <= PLAUSIBLE["offset_ft"]

@@ -26,6 +26,9 @@ DRIVEN_BY = {"alpha": ("de",), "q": ("de",), "theta": ("de",), "V": ("de",),
 # A driven state's filtered signal must stand this many times above the white noise the
 # common filter lets through (sigma * sqrt(mean(w^2)), Parseval on the sine series).
 DRIVEN_SNR = 5.0
+# A state whose filtered signal stands this far above that noise moved, whatever moved it (a
+# lateral departure swings α by degrees with the stabilator still).
+SELF_EVIDENT_SNR = 25.0
 
 
 @dataclass(frozen=True)
@@ -195,17 +198,19 @@ def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weig
     A surface counts when it is ``excited`` (its smoothed signal at least 5 times its noise).
     A state counts when a surface of its group moved (:data:`DRIVEN_BY`: the lateral states
     need an aileron or rudder input, the longitudinal ones a stabilator input) *and* its
-    filtered, detrended signal stands ``snr`` times above the white noise the filter passes.
+    filtered, detrended signal stands ``snr`` times above the white noise the filter passes,
+    or when it stands :data:`SELF_EVIDENT_SNR` times above it whatever moved it.
     Coloured sensor noise inside the band can pass the second test; the first is what keeps
     a pitch maneuver's β, p and r out of the analysis."""
     surfaces = [s for s in ("de", "da", "dr") if s in excited]
     out = list(surfaces)
     for state, group in DRIVEN_BY.items():
-        if state not in smooth or not any(g in surfaces for g in group):
+        if state not in smooth:
             continue
         x = smooth[state]
         signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
-        if signal >= snr * max(filtered_noise_std(noise.get(state, 0.0), weights), 1e-12):
+        ratio = signal / max(filtered_noise_std(noise.get(state, 0.0), weights), 1e-12)
+        if (ratio >= snr and any(g in surfaces for g in group)) or ratio >= SELF_EVIDENT_SNR:
             out.append(state)
     return tuple(out)
 

@@ -171,6 +171,8 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     ``status`` is 'confirmed' (the mismatch RMS drops by 1 % or more), 'contradicted' (it
     rises by 1 % or more) or 'neutral'; None for a finding with no coefficient term (a
     sensor effect, a gust level, a spectral peak)."""
+    if f.test.startswith("kinematic consistency") or f.parameter == "x_accelerometer":
+        return _sensor_check(av, f)
     after, n_terms = _after_mismatch(av, [f])
     axes = [c for c in COEFFICIENTS if n_terms[c]]
     if not axes:
@@ -182,6 +184,27 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
     return {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms,
             "change": ratio - 1.0}
+
+
+# The |t| the same sensor parameter must reach, with the same sign, on the validation
+# maneuver for a sensor finding to be kept (the same instrument flew both maneuvers).
+SENSOR_CONFIRM_T = 3.0
+
+
+def _sensor_check(av: Analysis, f: Candidate) -> dict:
+    """A sensor finding tested on the validation maneuver: the instrument is the same, so its
+    parameter, estimated there by the same kinematic check, must show with the same sign and
+    |t| >= :data:`SENSOR_CONFIRM_T` ('confirmed'); of the opposite sign at that |t|,
+    'contradicted'; else 'neutral'."""
+    twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
+    if twin is None:
+        return {"status": "neutral", "axes": [], "estimate": None, "t": None,
+                "reason": "the validation maneuver does not test this parameter"}
+    same = np.sign(twin.estimate) == np.sign(f.estimate)
+    status = ("confirmed" if same and abs(twin.t) >= SENSOR_CONFIRM_T else
+              "contradicted" if not same and abs(twin.t) >= SENSOR_CONFIRM_T else "neutral")
+    return {"status": status, "axes": [], "estimate": float(twin.estimate), "std_error": float(twin.std_error),
+            "t": float(twin.t)}
 
 
 def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
@@ -608,14 +631,17 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     check_model_represents(a, model)
     findings = _findings(a)
     checks: dict[int, dict | None] = {}
+    unconfirmed: list[Candidate] = []
     av = None
     if validation is not None:
         pv = prepare(read_recording(validation), "validation")
         av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.altitude))
         checks = {id(f): validation_check(av, f) for f in findings}
-        # a finding the validation maneuver contradicts is reported but not modelled
-        findings = sorted(findings, key=lambda f: (checks[id(f)] or {}).get("status") == "contradicted")
-    modelled = [f for f in findings if (checks.get(id(f)) or {}).get("status") != "contradicted"]
+        # a finding is kept only when the validation maneuver confirms it (or cannot test it:
+        # a gust level, a spectral peak); the others are reported apart, not as findings
+        unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"] != "confirmed"]
+        findings = [f for f in findings if f not in unconfirmed]
+    modelled = list(findings)
     added = tuple(e for e in (_effect_of(f) for f in modelled) if e is not None)
     timing = {"analysis": time.perf_counter() - t0}
     # the recording as prepared (``a.prepared`` carries the sensor corrections; fits are
@@ -647,6 +673,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         "findings": [_finding_dict(f, fits_b, fits_a, checks.get(id(f))) for f in findings]
         or [_none_finding(a, fits_b)],
         "located": located,
+        "not_confirmed": [_finding_dict(f, {}, {}, checks.get(id(f))) for f in unconfirmed],
         "assumptions": assumptions(a, aircraft, mass),
         "not_checked": not_checked(a, validation is not None),
         "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
