@@ -495,12 +495,28 @@ def verdict_section(data: Mapping) -> Section:
     findings = _findings(data)
     real = _real(findings)
     evidence = evidence_table(real or findings)
+    unconfirmed = _unconfirmed_table(data)
     if not real:
-        return Section("Verdict", (_none_line(findings),), _figs(evidence))
+        return Section("Verdict", (_none_line(findings),), _figs(evidence, unconfirmed))
     intro = (f"{len(real)} effect{'s' if len(real) > 1 else ''} found, most significant first. "
              "Each is a term the model as given lacks, estimated from the mismatch between the "
              "recording and the model.")
-    return Section("Verdict", (intro,), _figs(findings_table(real), evidence))
+    return Section("Verdict", (intro,), _figs(findings_table(real), evidence, unconfirmed))
+
+
+def _unconfirmed_table(data: Mapping) -> Table | None:
+    """Terms the identification maneuver called for that the validation maneuver did not
+    confirm (findings.json's ``not_confirmed``): reported, not findings, not modelled."""
+    rows = [{"effect": str(f.get("effect", "")), "parameter": _scalar(f.get("parameter")),
+             "estimate": _num(f.get("estimate")), "std_error": _num(f.get("std_error")),
+             "units": _scalar(f.get("units")),
+             "on validation": _dict(_dict(f.get("evidence")).get("validation")).get("status", "—")}
+            for f in data.get("not_confirmed") or [] if isinstance(f, Mapping)]
+    if not rows:
+        return None
+    return Table("Not confirmed on the validation maneuver", pd.DataFrame(rows),
+                 "Terms the identification maneuver called for but the validation maneuver did not confirm "
+                 "(neutral or contradicted): not findings, and left out of the augmented model.")
 
 
 def _located_lines(located: Mapping) -> tuple[str, ...]:
