@@ -412,8 +412,14 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
     return paths
 
 
+# Names the diagnosis gives the same parameter: the accelerometer's x position from the
+# force-mismatch fit (x_accelerometer) or from the kinematic check (offset_x).
+ALIASES = {("sensor_offset", "offset_x"): ("sensor_offset", "x_accelerometer")}
+
+
 def _key(f: dict) -> tuple[str, str]:
-    return f.get("effect"), f.get("parameter")
+    key = (f.get("effect"), f.get("parameter"))
+    return ALIASES.get(key, key)
 
 
 def score(c: OutsideCase, result: dict) -> dict:
