@@ -80,9 +80,12 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                          0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * 32.174)
     turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
     # 1. sensors: kinematic consistency says what the instruments did
-    kin = kinematic_check(p)
+    kin = plausible_kinematic_check(p)
     V0 = float(np.mean(p.smooth["V"]))
-    plausible = all(is_plausible(n, kin.selection.params[n], V0) for n in kin.forced + kin.selection.names)
+    # an estimate the data do not support (|t| < APPLY_T, e.g. a lateral bias on a pitch
+    # maneuver) says nothing about plausibility
+    plausible = all(is_plausible(n, kin.selection.params[n], V0) or _t_of(kin, n) < APPLY_T
+                    for n in kin.forced + kin.selection.names)
     # an implausible estimate means the kinematics disagree for another reason: then no
     # sensor correction is applied at all (they were estimated together)
     # and only estimates the data support (|t| >= APPLY_T) correct the channels: a nuisance bias
@@ -226,6 +229,28 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
 
 # The |t| a kinematic estimate needs before it corrects the channels the model is evaluated on.
 APPLY_T = 3.0
+
+
+# Passes of the kinematic check that drop implausible parameters before giving up on it.
+KINEMATIC_PASSES = 4
+
+
+def plausible_kinematic_check(p: Prepared) -> KinematicResult:
+    """The kinematic check, refitted without the parameters whose estimates no instrument
+    could have (:func:`kinematics.is_plausible`): nearly collinear pairs (an a_z bias and
+    scale where a_z stays near -1 g) can run to offsetting absurd values and take the true
+    sensor error with them. At most :data:`KINEMATIC_PASSES` fits; the last is returned."""
+    V0 = float(np.mean(p.smooth["V"]))
+    exclude: frozenset[str] = frozenset()
+    for _ in range(KINEMATIC_PASSES):
+        kin = kinematic_check(p, exclude=exclude)
+        bad = {n for n in kin.forced + kin.selection.names
+               if not is_plausible(n, kin.selection.params[n], V0) and _t_of(kin, n) >= APPLY_T}
+        bad -= set(kin.forced)  # the nuisance biases stay in every fit
+        if not bad:
+            return kin
+        exclude |= bad
+    return kin
 
 
 def _kin_share(kin: KinematicResult, name: str, value: float, p: Prepared) -> float:

@@ -150,7 +150,8 @@ class KinematicResult:
 T_IN = 6.0
 
 
-def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, max_terms: int = 8) -> KinematicResult:
+def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, max_terms: int = 8,
+                    exclude: frozenset[str] = frozenset()) -> KinematicResult:
     """Select the sensor parameters the kinematics call for (module docstring).
 
     The entry t is 6 rather than the aerodynamic 5: the kinematic residuals carry the
@@ -193,6 +194,9 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
             if corr > MAX_SCALE_BIAS_CORRELATION:
                 dropped[f"scale_{c}"] = f"indistinguishable from bias_{c} (correlation {corr:.3f}): {c} hardly moves"
                 columns.pop(f"scale_{c}")
+    for name in exclude:  # parameters an earlier pass found implausible (see analysis)
+        if columns.pop(name, None) is not None:
+            dropped[name] = "implausible size in an earlier fit: refitted without it"
     forced = {f"bias_{c}": columns.pop(f"bias_{c}") for c in NUISANCE_BIASES if f"bias_{c}" in columns}
     sel = colored_forward_selection(stack, columns, forced=forced, t_in=t_in, min_gain=min_gain, max_terms=max_terms,
                                     constant=False)
@@ -202,11 +206,11 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
 
 
 # The largest error an instrument of each kind plausibly has (a vane 5 deg off, a gyro 5 deg/s,
-# an accelerometer 0.2 g, an airspeed 15 % of its value, a scale factor 50 %, a skew 0.5 s, a
+# an accelerometer 0.2 g, an airspeed 5 % of its value, a scale factor (per channel below), a skew 0.5 s, a
 # sensor 30 ft from the c.g.): a kinematic fit that asks for more is not seeing a sensor
 # error but some other inconsistency (unmodelled vane noise, a missing channel), and its
 # estimate is neither named nor used to correct the channels.
-PLAUSIBLE = {"bias": {"alpha": 5.0 * DEG, "beta": 5.0 * DEG, "V": 0.15, "p": 5.0 * DEG, "q": 5.0 * DEG,
+PLAUSIBLE = {"bias": {"alpha": 5.0 * DEG, "beta": 5.0 * DEG, "V": 0.05, "p": 5.0 * DEG, "q": 5.0 * DEG,
                       "r": 5.0 * DEG, "phi": 5.0 * DEG, "theta": 5.0 * DEG, "ax": 0.2, "ay": 0.2, "az": 0.2},
              "scale": {"alpha": 0.3, "beta": 0.3, "V": 0.1}, "skew_s": 0.5, "offset_ft": 30.0}
 # (vanes: upwash scale errors of tens of percent are real; a pitot-static airspeed 10 %;
