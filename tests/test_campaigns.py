@@ -190,9 +190,11 @@ def test_every_builtin_campaign_runs_from_the_command_line(name, tmp_path, capsy
     assert len(scores) and np.isfinite(scores["mean"]).any()
 
 
-def test_builtin_campaign_names_are_the_six_of_the_issue():
+def test_builtin_campaign_names():
+    """The six of the campaigns issue and the turbulence campaign of the output-error one."""
     assert sorted(p.stem for p in BUILTIN_DIR.glob("*.toml")) == sorted(
-        ["regressor-noise", "error-bounds", "collinearity", "multiple-maneuvers", "maneuver-design", "nightly"])
+        ["regressor-noise", "error-bounds", "collinearity", "multiple-maneuvers", "maneuver-design", "nightly",
+         "turbulence"])
 
 
 def test_scores_against_hand_computed_values():
