@@ -200,6 +200,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
         selections[axis] = (sel, by_key)
     cands += _aero_candidates(selections, delays, p.dt, shares)
+    _withhold_ambiguous(cands, kin)
     # 6. spectra and gusts
     peak = structural_peak(p)
     if peak is not None:
@@ -231,7 +232,30 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
 APPLY_T = 3.0
 
 
-# Passes of the kinematic check that drop implausible parameters before giving up on it.
+# A coefficient error on a regressor whose own sensor the kinematic check suspects at this
+# |t| (a bias, scale factor, skew or vane offset of that channel, even below its entry t) is
+# not named: a wrong α (or β, q ...) reading imitates a wrong derivative on α.
+AMBIGUOUS_T = 2.5
+
+
+def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
+    """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
+    channel they are built on (:data:`AMBIGUOUS_T`); the reason names the rival."""
+    suspects: dict[str, tuple[str, float]] = {}
+    for name, sp in kin.parameters.items():
+        if name in kin.selection.params:
+            t = _t_of(kin, name)
+            if t >= AMBIGUOUS_T and t > suspects.get(sp.channel, ("", 0.0))[1]:
+                suspects[sp.channel] = (name, t)
+    for c in cands:
+        if not (c.selected and c.effect == "coefficient_error"):
+            continue
+        channel = cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
+        if channel in suspects:
+            rival, t = suspects[channel]
+            c.selected = False
+            c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({rival}, "
+                        f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
 KINEMATIC_PASSES = 4
 
 
