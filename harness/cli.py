@@ -88,7 +88,18 @@ def _parser() -> argparse.ArgumentParser:
                    choices=["auto", "recorded", "smooth-local", "smooth-fourier", "local-smooth"],
                    help="pdot/qdot/rdot for Eqs. 3-5: recorded channels, or the seed's differentiation "
                         "method 1, 2 or 3 (auto: recorded if present, else method 1)")
-    e.add_argument("--json", default=None, help="write the result to this JSON file")
+    e.add_argument("--truth", default="local", choices=["local", "fit"],
+                   help="which truth a simulated recording's table shows beside the estimates: the local slope "
+                        "at trim or the fit over the excursion (default local)")
+    e.add_argument("--json", default=None,
+                   help="write the result to this JSON file: estimates, bounds, t and p values, residuals, fitted "
+                        "values, regressors and every option (default: none)")
+    e.add_argument("--csv", default=None,
+                   help="write one row per parameter to this CSV file: estimate, std error, t, p, 95%% interval "
+                        "and, on a simulated recording, truth and error in standard errors (default: none)")
+    e.add_argument("--report", default=None, metavar="DIR",
+                   help="write DIR/report.html (self-contained): measured vs model, residual and its spectrum, "
+                        "regressors, estimates with bounds and truth (default: none)")
     e.set_defaults(func="harness.commands:cmd_estimate")
 
     c = sub.add_parser("campaign", help="run a Monte Carlo campaign and print its scores",

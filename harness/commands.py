@@ -81,13 +81,31 @@ def fly_default(out: Path) -> Path:
     return path
 
 
+def _check_estimate_outputs(args: argparse.Namespace) -> None:
+    """Refuse bad output paths before the fit (not after it was printed)."""
+    from harness.atomic import _first_file_on_the_way
+    from harness.errors import OutputPathError
+
+    if args.json:
+        check_output_file(args.json, "--json file")
+    if getattr(args, "csv", None):
+        check_output_file(args.csv, "--csv file")
+    if getattr(args, "report", None):
+        folder = Path(args.report)
+        if folder.exists() and not folder.is_dir():
+            raise OutputPathError(f"{folder}: cannot write the --report folder here: it is a file")
+        blocker = _first_file_on_the_way(folder.parent)
+        if blocker is not None:
+            raise OutputPathError(f"{folder}: cannot create the --report folder: {blocker} is a file, not a folder")
+
+
 def cmd_estimate(args: argparse.Namespace) -> int:
     from estimators.methods import make_estimator, parse_frequencies
     from estimators.regressors import DataOptions, Equation
+    from harness.estimate_run import OE_METHODS, equation_time_histories, output_error_time_histories
     from harness.recording_io import read_recording
 
-    if args.json:
-        check_output_file(args.json, "--json file")  # before the fit, not after it was printed
+    _check_estimate_outputs(args)
     if args.max_lag is not None and args.max_lag < 0:
         raise OptionError(f"--max-lag must be at least 0, not {args.max_lag}")
     try:
@@ -105,19 +123,65 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
                                detrend=args.detrend, data=data)
     fit = estimator.fit(rec, equation)
-    print(f"{args.recording}: " + (equation.describe() if args.method not in ("oe", "oe-freq", "fe") else  # oe fits its model's terms
-                                   f"output error, {fit.info['model']} model, outputs {fit.dependent}"))
-    print(fit.summary())
-    if args.json:
-        write_json_atomic(args.json, fit.to_dict())
-        print(f"wrote {args.json}")
+    if args.method in OE_METHODS:  # oe fits its model's terms
+        print(f"{args.recording}: output error, {fit.info['model']} model, outputs {fit.dependent}")
+        time, regs, notes = output_error_time_histories(rec, fit)
+        names = tuple(regs.columns) if regs is not None else ()
+    else:
+        print(f"{args.recording}: {equation.describe()}")
+        time, regs, notes = equation_time_histories(rec, equation, data, fit)
+        names = equation.regressors
+    _finish_estimate(args, rec, fit, time, regs, names, notes)
     return 0
+
+
+def _finish_estimate(args, rec, fit, time, regs, names, notes) -> None:
+    """Print the table (with the truth when the recording carries it) and write --json, --csv, --report."""
+    from harness.estimate_run import EstimateRun, options_of, truth_of
+
+    definition = getattr(args, "truth", "local") or "local"
+    truth = truth_of(rec.meta, definition)
+    simulated = bool(truth)
+    if simulated and getattr(args, "reference", "trim") == "trim" and "bias" in fit.names:
+        trim = (rec.meta.get("truth") or {}).get("trim_coefficients") or {}
+        if fit.dependent in trim:
+            truth["bias"] = float(trim[fit.dependent])
+    print(fit.summary(truth=truth if simulated else None))
+    if simulated:
+        print(f"truth: the recording's {definition} derivatives; error/se = (estimate - truth) / std error")
+    run = EstimateRun(recording=str(args.recording), fit=fit, options=options_of(args), truth=truth,
+                      truth_definition=definition, simulated=simulated, time=time, regressors=regs,
+                      regressor_names=tuple(names), notes=tuple(notes))
+    if args.json:
+        write_json_atomic(args.json, _finite(run.to_dict()))
+        print(f"wrote {args.json}")
+    if getattr(args, "csv", None):
+        from harness.atomic import write_text_atomic
+        write_text_atomic(args.csv, run.parameter_table().to_csv(index=False, float_format="%.17g"))
+        print(f"wrote {args.csv}")
+    if getattr(args, "report", None):
+        import importlib
+        html = importlib.import_module("reports.estimate_report").write_estimate_report(run, args.report)
+        print(f"wrote {html}")
+
+
+def _finite(obj):
+    """NaN and inf as null, so the JSON is strict."""
+    import math
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    return obj
 
 
 def _estimate_model_file(args: argparse.Namespace) -> int:
     """``estimate --method oe --model-file FILE``: output error for the model the file defines."""
     from estimators.dynamic_models import load_model_file
     from estimators.output_error import OutputError
+    from harness.estimate_run import output_error_time_histories
     from harness.recording_io import read_recording
 
     if args.method != "oe":
@@ -129,10 +193,8 @@ def _estimate_model_file(args: argparse.Namespace) -> int:
     fit = OutputError(model=model).fit(rec)
     print(f"{args.recording}: model {model.name} from {args.model_file} (outputs {', '.join(model.outputs)}; "
           f"inputs {', '.join(model.inputs) or 'none'})")
-    print(fit.summary())
-    if args.json:
-        write_json_atomic(args.json, fit.to_dict())
-        print(f"wrote {args.json}")
+    time, regs, notes = output_error_time_histories(rec, fit)
+    _finish_estimate(args, rec, fit, time, regs, tuple(model.inputs), notes)
     return 0
 
 

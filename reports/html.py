@@ -27,6 +27,7 @@ _KIND_LABELS = {
     "benchmark": "Benchmark report",
     "maneuver-review": "Maneuver review",
     "diagnosis": "Discrepancy diagnosis",
+    "estimate": "Estimate",
 }
 
 _CSS = """

@@ -34,7 +34,7 @@ __all__ = [
     "jsonable", "png_size", "provenance_items", "iter_tables",
 ]
 
-KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis")
+KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis", "estimate")
 """The kinds of report the project writes."""
 STATUSES: tuple[str, ...] = ("ok", "fail", "findings")
 """Report outcomes (the nightly gate's verdict; ``ok`` for reports without a gate)."""
