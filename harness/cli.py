@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from harness.flying import add_flight_options
+from harness.flying import AIRCRAFT_HELP, CONDITION_HELP, add_flight_options, add_noise_options
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -29,6 +29,7 @@ def _parser() -> argparse.ArgumentParser:
                        description="Trim, fly one maneuver open or closed loop, and write the "
                                    "recording (CSV + .meta.json, or Parquet) with its truth.")
     add_flight_options(f)
+    add_noise_options(f)
     f.add_argument("--out", required=True, help="output recording: NAME.csv (+ NAME.meta.json) or NAME.parquet")
     f.set_defaults(func="harness.commands:cmd_fly")
 
@@ -37,14 +38,14 @@ def _parser() -> argparse.ArgumentParser:
                                    "the c.g., per rad (rates normalised by cbar/2V and b/2V), by central "
                                    "differences of JSBSim's own aerodynamics: the local slope and the "
                                    "best linear fit over the default maneuvers' excursion.")
-    t.add_argument("--aircraft", default="f16", choices=["f16", "737"])
-    t.add_argument("--variant", default="nominal", choices=["nominal", "exact-truth", "unstable"])
-    t.add_argument("--condition", default=None,
-                   help="flight condition by name (default: the aircraft's first) or by value, "
-                        "h=<ft>,V=<ft/s true airspeed> (e.g. h=10000,V=427.4)")
-    t.add_argument("--json", default=None, help="write the derivatives to this JSON file")
+    t.add_argument("--aircraft", default="f16", metavar="f16|737|dhc6|PATH.xml", help=AIRCRAFT_HELP)
+    t.add_argument("--variant", default="nominal", choices=["nominal", "exact-truth", "unstable"],
+                   help="aircraft variant (default: nominal)")
+    t.add_argument("--condition", default=None, help=CONDITION_HELP)
+    t.add_argument("--json", default=None, help="write the derivatives to this JSON file (default: none)")
     t.add_argument("--check-linearization", action="store_true",
-                   help="also compare with jsbsim.FGLinearization and print the relative differences")
+                   help="also compare with jsbsim.FGLinearization and print the relative differences "
+                        "(default: off)")
     t.set_defaults(func="harness.commands:cmd_truth")
 
     i = sub.add_parser("import", help="convert a SIDPAC .mat file to the canonical recording format",
@@ -244,11 +245,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     _single_threaded_blas()
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv  # accepted anywhere on the line, before or after the subcommand
-    args = _parser().parse_args([a for a in argv if a != "--debug"])
+    from harness.errors import quiet_broken_pipe, run_reporting_errors
+    try:
+        args = _parser().parse_args([a for a in argv if a != "--debug"])
+    except BrokenPipeError:  # `sidbench x --help | head`
+        return quiet_broken_pipe()
     module, name = args.func.split(":")
     import importlib
 
-    from harness.errors import run_reporting_errors
     func = getattr(importlib.import_module(module), name)
     return run_reporting_errors(func, args, args.command, debug=debug)
 

@@ -9,34 +9,51 @@ from harness.errors import OptionError
 
 
 def cmd_fly(args: argparse.Namespace) -> int:
+    import dataclasses
+
     from harness.flying import spec_from_args
+    from harness.noise import apply_noise, stream
+    from harness.noise_presets import preset
     from harness.recording_io import write_recording
     from maneuvers.fly import fly_maneuver
 
     check_output_file(args.out, "--out recording")
     spec = spec_from_args(args)
+    noise_name = getattr(args, "noise", "none") or "none"
+    seed = int(getattr(args, "seed", 1))
+    noise = preset(noise_name)
+    if noise.turbulence is not None:  # flown, not added: drawn from the seed as a campaign draws it
+        spec = dataclasses.replace(spec, turbulence=noise.turbulence,
+                                   turbulence_seed=int(stream(seed, "turbulence").integers(1, 2**31 - 1)))
     rec = fly_maneuver(spec)
+    if noise_name != "none":
+        rec = apply_noise(rec, noise, seed)
     path = write_recording(rec, args.out)
     print(f"flew {spec.describe()}")
+    if noise_name != "none":
+        n = rec.meta["noise"]
+        print(f"noise {noise_name}, seed {seed}: corrupted {', '.join(n['channels'])}"
+              + (f"; dropped {', '.join(n['dropped'])}" if n["dropped"] else "")
+              + ("; Dryden turbulence flown" if noise.turbulence is not None else ""))
     print(f"wrote {path} ({rec.n} samples)" + (f" and {Path(path).with_suffix('.meta.json')}"
                                                if Path(path).suffix == ".csv" else ""))
     return 0
 
 
 def cmd_truth(args: argparse.Namespace) -> int:
+    from harness.flying import resolve_aircraft
     from maneuvers.fly import default_truth, truth_table
-    from models.aircraft import Aircraft
 
     if args.json:
         check_output_file(args.json, "--json file")
-    aircraft = Aircraft(args.aircraft, args.variant)
+    aircraft = resolve_aircraft(args.aircraft, args.variant)
     truth = default_truth(aircraft, args.condition)
     print(truth_table(truth))
     if args.check_linearization:
         from models.conditions import condition_for
         from models.exact import exact_truth_root
         from models.linearization import CHECKED, linearization_derivatives
-        cond = condition_for(args.aircraft, args.condition)
+        cond = condition_for(aircraft.model, args.condition)
         kwargs = {}
         if args.variant == "exact-truth":
             root, name = exact_truth_root(aircraft, cond)

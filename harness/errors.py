@@ -74,13 +74,32 @@ def _one_line(exc: BaseException) -> str:
     return text
 
 
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for a writer whose reader left
+
+
+def quiet_broken_pipe() -> int:
+    """The reader of our output went away (``sidbench … | head``): stop quietly. Standard output
+    is pointed at /dev/null so that Python's final flush has nowhere to fail."""
+    import os
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return EXIT_BROKEN_PIPE
+
+
 def run_reporting_errors(func: Callable[[Any], int | None], args: Any, command: str, *, debug: bool = False,
                          stream: TextIO | None = None) -> int:
     """Run ``func(args)`` and turn what it raises into a message and an exit status."""
     err = stream or sys.stderr
     prefix = f"sidbench {command}"
     try:
-        return int(func(args) or 0)
+        status = int(func(args) or 0)
+        sys.stdout.flush()
+        return status
+    except BrokenPipeError:
+        return quiet_broken_pipe()
     except KeyboardInterrupt as exc:
         if debug:
             traceback.print_exc(file=err)
