@@ -48,10 +48,18 @@ def _parser() -> argparse.ArgumentParser:
                         "(default: off)")
     t.set_defaults(func="harness.commands:cmd_truth")
 
-    i = sub.add_parser("import", help="convert a SIDPAC .mat file to the canonical recording format",
+    i = sub.add_parser("import", help="convert a SIDPAC .mat file, or a user's ASCII/CSV file with a column map, "
+                                      "to the canonical recording format",
                        description="Import a SIDPAC flight-test file (t, fdata, fds) into the canonical "
-                                   "format, keeping its computed coefficient and normalised-rate columns.")
-    i.add_argument("file", help="SIDPAC .mat file")
+                                   "format, keeping its computed coefficient and normalised-rate columns; or a "
+                                   "user's ASCII/CSV flight data (any delimiter, a header line) through a column "
+                                   "map (TOML: source column -> canonical <quantity>_<unit>, the time column, scale "
+                                   "factors, sign flips, the metadata; see harness/column_map.py). Prints every "
+                                   "change made (signs, derived channels, dropped columns).")
+    i.add_argument("file", help="SIDPAC .mat file, or with --column-map the user's ASCII/CSV data file")
+    i.add_argument("--column-map", default=None, metavar="MAP.toml",
+                   help="column map (TOML) for a user's ASCII/CSV file (default: none: FILE is a SIDPAC .mat or a "
+                        "canonical recording)")
     i.add_argument("--out", required=True, help="output recording (.csv or .parquet)")
     i.set_defaults(func="harness.commands:cmd_import")
 

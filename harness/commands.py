@@ -74,10 +74,22 @@ def cmd_import(args: argparse.Namespace) -> int:
     from harness.recording_io import read_recording, write_recording
 
     check_output_file(args.out, "--out recording")
-    rec = read_recording(args.file)
+    if getattr(args, "column_map", None):
+        from harness.column_map import import_with_map
+        rec = import_with_map(args.file, args.column_map)
+    else:
+        rec = read_recording(args.file)
     path = write_recording(rec, args.out)
     print(f"imported {args.file}: {rec.n} samples at {1 / rec.dt:g} Hz, channels "
           + ", ".join(c for c in rec.data.columns))
+    notes = rec.meta.get("import_notes", [])
+    if notes:
+        print("what the import changed or assumed:")
+        for note in notes:
+            print(f"  - {note}")
+    dropped = (rec.meta.get("sidpac") or {}).get("dropped") or []
+    if dropped:
+        print("dropped columns: " + "; ".join(dropped))
     print(f"wrote {path}")
     return 0
 
