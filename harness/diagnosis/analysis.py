@@ -201,6 +201,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         selections[axis] = (sel, by_key)
     cands += _aero_candidates(selections, delays, p.dt, shares)
     _withhold_ambiguous(cands, kin)
+    if turbulent:
+        _withhold_in_turbulence(cands)
     # 6. spectra and gusts
     peak = structural_peak(p)
     if peak is not None:
@@ -236,6 +238,20 @@ APPLY_T = 3.0
 # |t| (a bias, scale factor, skew or vane offset of that channel, even below its entry t) is
 # not named: a wrong α (or β, q ...) reading imitates a wrong derivative on α.
 AMBIGUOUS_T = 2.5
+
+
+NOT_IN_GUSTS = ("not named: in turbulence the aerodynamics see air-relative rates and accelerations the gyros and "
+                "accelerometers do not measure, which a rate, alpha-dot or accelerometer-position term would fit")
+
+
+def _withhold_in_turbulence(cands: list[Candidate]) -> None:
+    """In turbulence, deselect the terms the gusts themselves imitate: α̇ terms, rate
+    derivatives (q̂, p̂, r̂) and the accelerometer position from the force mismatch."""
+    for c in cands:
+        rate = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
+        if c.selected and (c.effect == "unsteady_alphadot" or rate or c.parameter == "x_accelerometer"):
+            c.selected = False
+            c.reason = NOT_IN_GUSTS
 
 
 def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
