@@ -16,6 +16,24 @@ from pathlib import Path
 from harness.flying import AIRCRAFT_HELP, CONDITION_HELP, add_flight_options, add_noise_options
 
 
+class _DefaultsFormatter(argparse.HelpFormatter):
+    """Every option's help ends with its default, unless the text already states it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if "default" in text.lower() or action.default is argparse.SUPPRESS or not action.option_strings \
+                or action.required or isinstance(action, argparse._HelpAction):
+            return text
+        d = action.default
+        if isinstance(action, argparse._StoreTrueAction):
+            shown = "off"
+        elif d is None:
+            shown = "none"
+        else:
+            shown = str(d)
+        return f"{text} (default: {shown})".strip()
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sidbench",
@@ -78,7 +96,9 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--model-file", default=None,
                    help="oe: a Python file defining `model` (estimators.dynamic_models.Model), fitted as written "
                         "instead of the built-in linear models; the file is code that runs: use only files you trust")
-    e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe"])
+    e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe"],
+                   help="ee-time, ee-smooth (smoothed regressors), ee-freq (frequency domain), oe (output error), "
+                        "oe-freq (output error in the frequency domain), fe (filter error)")
     e.add_argument("--errors", default=None, choices=["conventional", "colored"],
                    help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40); "
                         "default colored for ee-smooth, conventional for ee-time")
@@ -197,7 +217,8 @@ def _parser() -> argparse.ArgumentParser:
                        description="Write report.html (self-contained), report.md and report.json for a campaign "
                                    "output folder; --kind benchmark ranks the methods over one or more folders.")
     r.add_argument("dirs", nargs="+", help="campaign output folder(s)")
-    r.add_argument("--kind", default="campaign", choices=["campaign", "benchmark"])
+    r.add_argument("--kind", default="campaign", choices=["campaign", "benchmark"],
+                   help="campaign: one folder's report; benchmark: methods ranked over several folders")
     r.add_argument("--out", default=None, help="where to write (default: the first folder)")
     r.set_defaults(func="reports.commands:cmd_report")
 
@@ -210,12 +231,15 @@ def _parser() -> argparse.ArgumentParser:
     n.add_argument("--campaign", default="nightly", help="campaign to run (default: nightly)")
     n.add_argument("--gates", default=str(Path(__file__).resolve().parent / "nightly-gates.toml"),
                    help="gates file (TOML)")
-    n.add_argument("--realizations", type=int, default=None)
+    n.add_argument("--realizations", type=int, default=None,
+                   help="override the campaign's realizations per cell (default: the campaign's own)")
     n.add_argument("--nights", type=int, default=30, help="runs shown in the trends (default 30)")
-    n.add_argument("--workers", type=int, default=None)
-    n.add_argument("--scheduler", default=None)
-    n.add_argument("--cache", default=None)
-    n.add_argument("--quiet", action="store_true")
+    n.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    n.add_argument("--scheduler", default=None,
+                   help="'local' for a dask LocalCluster, or tcp://HOST:PORT of a Dask scheduler "
+                        "(default: a local process pool)")
+    n.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
+    n.add_argument("--quiet", action="store_true", help="no progress display")
     n.set_defaults(func="reports.commands:cmd_nightly")
 
     v = sub.add_parser("review-maneuvers", help="maneuver design review of candidate inputs",
@@ -223,19 +247,27 @@ def _parser() -> argparse.ArgumentParser:
                                    "and write review.html: input spectra against the modes, predicted Cramér-Rao "
                                    "bounds, regressor correlations (|r| > 0.9 flagged), excursions, accuracy, and a "
                                    "recommendation per parameter group.")
-    v.add_argument("--aircraft", default="f16", choices=["f16", "737"])
-    v.add_argument("--condition", default="seed-5deg")
+    v.add_argument("--aircraft", default="f16", choices=["f16", "737"], help="JSBSim model")
+    v.add_argument("--condition", default="seed-5deg",
+                   help="flight condition by name or by value, h=<ft>,V=<ft/s true airspeed>")
     v.add_argument("--maneuvers", default="doublet,2-1-1-2,3-2-1-1,sweep-linear,multisine",
                    help="comma list of input kinds (matched 6 s of motion and amplitude)")
-    v.add_argument("--axis", default="both", choices=["lon", "lat", "both"])
-    v.add_argument("--noise", default="realistic")
-    v.add_argument("--realizations", type=int, default=30)
-    v.add_argument("--out", required=True)
-    v.add_argument("--workers", type=int, default=None)
-    v.add_argument("--scheduler", default=None)
-    v.add_argument("--cache", default=None)
-    v.add_argument("--quiet", action="store_true")
+    v.add_argument("--axis", default="both", choices=["lon", "lat", "both"],
+                   help="longitudinal inputs (stabilator), lateral (aileron, rudder) or both")
+    v.add_argument("--noise", default="realistic",
+                   help="noise preset of the Monte Carlo realizations (harness/noise_presets.py)")
+    v.add_argument("--realizations", type=int, default=30, help="Monte Carlo realizations per maneuver")
+    v.add_argument("--out", required=True, help="output folder (review.html, .md, .json and the campaign output)")
+    v.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    v.add_argument("--scheduler", default=None,
+                   help="'local' for a dask LocalCluster, or tcp://HOST:PORT of a Dask scheduler "
+                        "(default: a local process pool)")
+    v.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
+    v.add_argument("--quiet", action="store_true", help="no progress display")
     v.set_defaults(func="reports.commands:cmd_review_maneuvers")
+    for command in sub.choices.values():
+        command.formatter_class = _DefaultsFormatter
+    p.formatter_class = _DefaultsFormatter
     return p
 
 
