@@ -61,9 +61,11 @@ def test_turbulence_campaign_filter_error_covers_where_output_error_does_not(tmp
     """The `turbulence` campaign cut to 50 realizations and oe, fe. Output error's ±2σ
     Cramér-Rao intervals are over-confident: every derivative's exact (Clopper-Pearson) 95 %
     interval for the coverage lies below 0.90. Filter error's CZ derivatives cover at the
-    nominal rate (the interval contains 0.95); its Cm derivatives fall short (0.76-0.88 over 100
-    realizations: README), so for all six only ≥ 0.70 is asserted: 0.78 measured on Cm_α, and
-    at n = 50 the binomial standard deviation is ≤ 0.065."""
+    nominal rate (the interval contains 0.95); its Cm derivatives (noise covariances estimated,
+    gain from the Riccati equation) still fall short on Cm_α: 0.82 [0.73, 0.89] over 100
+    realizations, Cm_q̂ and Cm_δe 0.90 [0.82, 0.95] (README), so for all six only ≥ 0.70 is
+    asserted (at n = 50 the binomial standard deviation is ≤ 0.065), and the standard errors
+    at least 0.6 of the scatter (0.67 measured on Cm_α, 0.59 with the gain estimated directly)."""
     n = 50
     text = CASE.replace("realizations = 100", f"realizations = {n}").replace(
         'method = ["oe", "fe", "ee-freq"]', 'method = ["oe", "fe"]')
@@ -81,6 +83,7 @@ def test_turbulence_campaign_filter_error_covers_where_output_error_does_not(tmp
         assert fe["coverage"] >= 0.70, (p, fe["coverage"])
         assert fe["coverage"] > oe["coverage"] + 0.3, p
         assert fe["se_ratio"] > 2 * oe["se_ratio"], p
+        assert fe["se_ratio"] > 0.6, (p, fe["se_ratio"])
         if p.startswith("CZ"):
             assert fe["coverage_lo"] <= 0.95 <= fe["coverage_hi"], (p, fe["coverage"])
     assert math.isfinite(s.loc[("fe", "Cm_alpha"), "bias_z"])
