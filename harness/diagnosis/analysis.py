@@ -136,8 +136,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven:
             states[k] = np.full(p.n, p.start[k])
-    surfaces = {s: (p.smooth[s] if s in p.driven else np.full(p.n, p.start[s]))
-                for s in ("de", "da", "dr") if s in p.smooth}
+    # surfaces are measured with little noise: always evaluated as recorded (holding one that
+    # moves, say by a feedback loop, would be far worse than its noise)
+    surfaces = {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth}
     # airspeed and altitude are slow: their own optimal smoothing (a far lower cut-off than the
     # common filter's) keeps their noise out of the model's coefficients (through q̂ = qc̄/2V,
     # dynamic pressure and Mach-scheduled terms)

@@ -29,6 +29,12 @@ DRIVEN_SNR = 5.0
 # A state whose filtered signal stands this far above that noise moved, whatever moved it (a
 # lateral departure swings α by degrees with the stabilator still).
 SELF_EVIDENT_SNR = 25.0
+# And it must move by at least this much (std about its trend, canonical units): a noise-free
+# pitch maneuver's lateral states wiggle by 1e-5 rad, far above a noise floor of zero.
+DRIVEN_FLOOR = {"alpha": 0.05 * np.pi / 180, "beta": 0.05 * np.pi / 180, "p": 0.1 * np.pi / 180,
+                "q": 0.1 * np.pi / 180, "r": 0.1 * np.pi / 180, "phi": 0.1 * np.pi / 180,
+                "theta": 0.1 * np.pi / 180, "V": 0.5, "de": 0.02 * np.pi / 180, "da": 0.02 * np.pi / 180,
+                "dr": 0.02 * np.pi / 180}
 
 
 @dataclass(frozen=True)
@@ -104,8 +110,20 @@ def common_weights(fits: dict, excited: tuple[str, ...], n: int) -> np.ndarray:
     record keeps z = Xθ exact through the filter."""
     chosen = [fits[c].weights for c in BANDWIDTH_CHANNELS if c in excited]
     if not chosen:
-        chosen = [fits[c].weights for c in BANDWIDTH_CHANNELS if c in fits]
+        # nothing passes the per-sample test (a small response at high dynamic pressure): the
+        # state whose own smoothing stands highest above the noise it lets through sets the band
+        # (the minimum over every state would smooth the whole maneuver away)
+        snr = {c: _own_snr(fits[c]) for c in BANDWIDTH_CHANNELS if c in fits}
+        if snr:
+            chosen = [fits[max(snr, key=snr.get)].weights]
     return np.min(chosen, axis=0) if chosen else np.ones(n - 2)
+
+
+def _own_snr(fit) -> float:
+    """A channel's own optimal smoothing over the white noise that smoothing lets through."""
+    x = fit.smoothed
+    signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
+    return signal / max(filtered_noise_std(float(np.sqrt(max(fit.noise_variance, 0.0))), fit.weights), 1e-12)
 
 
 def prepare(rec: Recording, name: str = "identification") -> Prepared:
@@ -202,15 +220,23 @@ def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weig
     or when it stands :data:`SELF_EVIDENT_SNR` times above it whatever moved it.
     Coloured sensor noise inside the band can pass the second test; the first is what keeps
     a pitch maneuver's β, p and r out of the analysis."""
-    surfaces = [s for s in ("de", "da", "dr") if s in excited]
+    def ratio(c: str) -> float:
+        x = smooth[c]
+        signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
+        if signal < DRIVEN_FLOOR.get(c, 0.0):
+            return 0.0
+        return signal / max(filtered_noise_std(noise.get(c, 0.0), weights), 1e-12)
+
+    # a surface moved when it is excited, or when its filtered signal stands clear of the noise
+    # the filter passes (a surface moved by a feedback loop every frame looks noisy sample to
+    # sample, yet moves)
+    surfaces = [s for s in ("de", "da", "dr") if s in smooth and (s in excited or ratio(s) >= snr)]
     out = list(surfaces)
     for state, group in DRIVEN_BY.items():
         if state not in smooth:
             continue
-        x = smooth[state]
-        signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
-        ratio = signal / max(filtered_noise_std(noise.get(state, 0.0), weights), 1e-12)
-        if (ratio >= snr and any(g in surfaces for g in group)) or ratio >= SELF_EVIDENT_SNR:
+        r = ratio(state)
+        if (r >= snr and any(g in surfaces for g in group)) or r >= SELF_EVIDENT_SNR:
             out.append(state)
     return tuple(out)
 
