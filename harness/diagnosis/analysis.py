@@ -236,9 +236,12 @@ APPLY_T = 3.0
 
 
 # A coefficient error on a regressor whose own sensor the kinematic check suspects at this
-# |t| (a bias, scale factor, skew or vane offset of that channel, even below its entry t) is
-# not named: a wrong α (or β, q ...) reading imitates a wrong derivative on α.
+# |t| (a scale factor, skew or vane offset of that channel, even below its entry t) is not
+# named: a scaled α (or β, q ...) reading is exactly a scaled derivative on α. A bias is not
+# a rival: the regression's constant absorbs it (it imitates a derivative only through the
+# model's nonlinearity).
 AMBIGUOUS_T = 2.5
+AMBIGUOUS_KINDS = ("scale", "skew", "vane")
 
 
 NOT_IN_GUSTS = ("not named: in turbulence the aerodynamics see air-relative rates and accelerations the gyros and "
@@ -260,7 +263,7 @@ def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
     channel they are built on (:data:`AMBIGUOUS_T`); the reason names the rival."""
     suspects: dict[str, tuple[str, float]] = {}
     for name, sp in kin.parameters.items():
-        if name in kin.selection.params:
+        if name in kin.selection.params and name.split("_", 1)[0] in AMBIGUOUS_KINDS:
             t = _t_of(kin, name)
             if t >= AMBIGUOUS_T and t > suspects.get(sp.channel, ("", 0.0))[1]:
                 suspects[sp.channel] = (name, t)
