@@ -36,11 +36,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from harness import isa
 from harness.errors import UserError
 from maneuvers.recording import FORMAT_ID, Recording, RecordingError, to_canonical
 
 KNOWN_KEYS = {"delimiter", "comment", "skip_rows", "time", "time_scale", "columns", "scale", "negate", "meta"}
-_GAMMA_AIR = 1.4
 
 
 class ColumnMapError(UserError):
@@ -141,7 +141,7 @@ def import_with_map(data_path: str | Path, map_path: str | Path) -> Recording:
     frame = to_canonical(pd.DataFrame(channels), source)
     if "qbar_psf" not in frame.columns and {"mach_1", "h_ft"} <= set(frame.columns):
         from harness.sidpac import isa_pressure_psf
-        frame["qbar_psf"] = 0.5 * _GAMMA_AIR * isa_pressure_psf(frame["h_ft"].to_numpy()) * frame["mach_1"] ** 2
+        frame["qbar_psf"] = 0.5 * isa.GAMMA_AIR * isa_pressure_psf(frame["h_ft"].to_numpy()) * frame["mach_1"] ** 2
         notes.append("qbar_psf computed as 0.5*gamma*p*M^2 (gamma 1.4) from mach and h (pressure altitude, ISA "
                      "static pressure).")
     converted = [f"{src} -> {dst}" for src, dst in mapping.items() if not dst.endswith(_canonical_unit(dst))]

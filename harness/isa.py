@@ -16,6 +16,7 @@ G0_MPS2 = 9.80665
 TROPOPAUSE_M = 11000.0
 TOP_M = 20000.0
 FT_M = 0.3048
+GAMMA_AIR = 1.4  # ratio of specific heats of air
 SLUGFT3_PER_KGM3 = 0.0019403203  # 1 kg/m^3 in slug/ft^3
 _EXPONENT = G0_MPS2 / (R_J_PER_KG_K * LAPSE_K_PER_M)  # g/(R L), about 5.256
 _T11 = T0_K - LAPSE_K_PER_M * TROPOPAUSE_M
@@ -50,3 +51,8 @@ def density_altitude_ft(rho_slugft3: npt.ArrayLike) -> np.ndarray:
     tropo_m = (T0_K - T0_K * (rho / _RHO0) ** (1.0 / (_EXPONENT - 1.0))) / LAPSE_K_PER_M
     strato_m = TROPOPAUSE_M - np.log(rho / _RHO11) * R_J_PER_KG_K * _T11 / G0_MPS2
     return np.where(rho >= _RHO11, tropo_m, strato_m) / FT_M
+
+
+def dynamic_pressure_from_mach_pa(h_ft: npt.ArrayLike, mach: npt.ArrayLike) -> np.ndarray:
+    """q̄ = (γ/2) p M² at pressure altitude ``h_ft`` (ISA), Pa."""
+    return 0.5 * GAMMA_AIR * pressure_pa(h_ft) * np.asarray(mach, dtype=np.float64) ** 2

@@ -45,6 +45,8 @@ import numpy as np
 import pandas as pd
 import scipy.io
 
+from harness import isa
+
 from maneuvers.recording import (
     CHANNELS,
     FORMAT_ID,
@@ -95,16 +97,10 @@ _MASS_QUANTITIES = ("mass", "Ix", "Iy", "Iz", "Ixz")
 _CG_LABELS = ("xcg", "ycg", "zcg")
 _GEOMETRY_FIELDS = {"sarea": "S_ft2", "bspan": "b_ft", "cbar": "cbar_ft"}
 
-# ISA (ICAO standard atmosphere) constants, SI.
-_ISA_T0_K = 288.15
-_ISA_P0_PA = 101325.0
-_ISA_LAPSE_K_PER_M = 0.0065
-_ISA_R_J_PER_KG_K = 287.05287
-_ISA_G0 = 9.80665
-_ISA_TROPOPAUSE_M = 11000.0
-_ISA_TOP_M = 20000.0
-_GAMMA_AIR = 1.4
-_FT_M = 0.3048
+# ISA (ICAO standard atmosphere): harness.isa, the one home of its constants.
+_ISA_R_J_PER_KG_K = isa.R_J_PER_KG_K
+_GAMMA_AIR = isa.GAMMA_AIR
+_FT_M = isa.FT_M
 
 
 def isa_pressure_psf(h_ft: np.ndarray) -> np.ndarray:
@@ -125,15 +121,7 @@ def isa_pressure_psf(h_ft: np.ndarray) -> np.ndarray:
     ValueError
         If an altitude lies above 20 km (65617 ft), beyond the two layers modelled.
     """
-    h_m = np.asarray(h_ft, dtype=np.float64) * _FT_M
-    if np.any(h_m > _ISA_TOP_M):
-        raise ValueError(f"altitude above {_ISA_TOP_M / _FT_M:.0f} ft is outside the ISA layers modelled")
-    exponent = _ISA_G0 / (_ISA_R_J_PER_KG_K * _ISA_LAPSE_K_PER_M)
-    t11 = _ISA_T0_K - _ISA_LAPSE_K_PER_M * _ISA_TROPOPAUSE_M
-    p11 = _ISA_P0_PA * (t11 / _ISA_T0_K) ** exponent
-    tropo = _ISA_P0_PA * (1.0 - _ISA_LAPSE_K_PER_M * np.minimum(h_m, _ISA_TROPOPAUSE_M) / _ISA_T0_K) ** exponent
-    strato = p11 * np.exp(-_ISA_G0 * (h_m - _ISA_TROPOPAUSE_M) / (_ISA_R_J_PER_KG_K * t11))
-    p_pa = np.where(h_m <= _ISA_TROPOPAUSE_M, tropo, strato)
+    p_pa = isa.pressure_pa(h_ft)
     return p_pa * CHANNELS["qbar"].units["pa"]
 
 
@@ -346,7 +334,7 @@ def import_sidpac(path: str | Path) -> Recording:
                 a_fps = v / mach
                 t_implied = np.mean((a_fps * _FT_M) ** 2 / (_GAMMA_AIR * _ISA_R_J_PER_KG_K))
                 h_m = np.mean(h) * _FT_M
-                t_isa = _ISA_T0_K - _ISA_LAPSE_K_PER_M * min(h_m, _ISA_TROPOPAUSE_M)
+                t_isa = isa.T0_K - isa.LAPSE_K_PER_M * min(h_m, isa.TROPOPAUSE_M)
                 note += (f"; check: static temperature implied by V/mach {t_implied:.1f} K, "
                          f"ISA at mean altitude {t_isa:.1f} K")
             notes.append(note + ".")
