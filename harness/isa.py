@@ -52,7 +52,3 @@ def density_altitude_ft(rho_slugft3: npt.ArrayLike) -> np.ndarray:
     strato_m = TROPOPAUSE_M - np.log(rho / _RHO11) * R_J_PER_KG_K * _T11 / G0_MPS2
     return np.where(rho >= _RHO11, tropo_m, strato_m) / FT_M
 
-
-def dynamic_pressure_from_mach_pa(h_ft: npt.ArrayLike, mach: npt.ArrayLike) -> np.ndarray:
-    """q̄ = (γ/2) p M² at pressure altitude ``h_ft`` (ISA), Pa."""
-    return 0.5 * GAMMA_AIR * pressure_pa(h_ft) * np.asarray(mach, dtype=np.float64) ** 2
