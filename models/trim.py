@@ -138,12 +138,7 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
         Naming the aircraft, the condition and why no equilibrium exists there (not enough
         thrust, not enough lift or pitch control within the surfaces' travel).
     """
-    set_initial_condition(fdm, condition.h_ft, condition.V_fps)
-    config = cruise_configuration(model_xml(aircraft.model))
-    written = command_configuration(fdm, config)
-    fdm["propulsion/set-running"] = -1
-    fdm.run_ic()
-    written.update(place_configuration(fdm, config))
+    config, written = _initialise_in_cruise(fdm, aircraft, condition)
     if place_reference_point(fdm, aircraft):
         fdm.run_ic()
     turboprop = is_turboprop(aircraft.model)
@@ -171,6 +166,18 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
         settle_engines(fdm)
     return read_trim_point(fdm, condition.name, aircraft.surfaces,
                            configuration=configuration_record(fdm, config, written), held=held, method=method)
+
+
+def _initialise_in_cruise(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition):
+    """Initial condition, cruise configuration (:mod:`models.configuration`) and running
+    engines; returns the configuration and the properties written."""
+    set_initial_condition(fdm, condition.h_ft, condition.V_fps)
+    config = cruise_configuration(model_xml(aircraft.model))
+    written = command_configuration(fdm, config)
+    fdm["propulsion/set-running"] = -1
+    fdm.run_ic()
+    written.update(place_configuration(fdm, config))
+    return config, written
 
 
 def _where(aircraft: Aircraft, condition: FlightCondition) -> str:
@@ -340,12 +347,7 @@ def place_untrimmed(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: Flight
     cruise configuration with the FCS disabled, without looking for an equilibrium: for
     evaluating the aerodynamics where the model cannot trim (the returned point's ``method``
     is ``'untrimmed'``; its accelerations are not zero)."""
-    set_initial_condition(fdm, condition.h_ft, condition.V_fps)
-    config = cruise_configuration(model_xml(aircraft.model))
-    written = command_configuration(fdm, config)
-    fdm["propulsion/set-running"] = -1
-    fdm.run_ic()
-    written.update(place_configuration(fdm, config))
+    config, written = _initialise_in_cruise(fdm, aircraft, condition)
     place_reference_point(fdm, aircraft)
     fdm["simulation/models/FGFCS/enabled"] = 0
     set_initial_condition(fdm, condition.h_ft, condition.V_fps)
