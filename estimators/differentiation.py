@@ -147,12 +147,7 @@ def local_polynomial_derivative(
         raise ValueError("x must be real")
     a = a.astype(float)
     dt = float(dt)
-    if not (np.isfinite(dt) and dt > 0.0):
-        raise ValueError("dt must be a positive finite number")
-    if int(window) != window or window < 3 or window % 2 == 0:
-        raise ValueError("window must be an odd integer >= 3")
-    if int(order) != order or not (1 <= order < window):
-        raise ValueError("order must be an integer with 1 <= order < window")
+    _check_local_polynomial(dt, window, order)
     if a.ndim == 0 or a.shape[axis] < window:
         raise ValueError(f"x needs at least window={window} samples along axis {axis}")
     return signal.savgol_filter(
@@ -191,12 +186,7 @@ def local_derivative_noise_shape(
         ``f_hz -> |H(f_hz)|**2`` (in (1/s)**2).
     """
     dt = float(dt)
-    if not (np.isfinite(dt) and dt > 0.0):
-        raise ValueError("dt must be a positive finite number")
-    if int(window) != window or window < 3 or window % 2 == 0:
-        raise ValueError("window must be an odd integer >= 3")
-    if int(order) != order or not (1 <= order < window):
-        raise ValueError("order must be an integer with 1 <= order < window")
+    _check_local_polynomial(dt, window, order)
     m = int(window) // 2
     # use="dot": coefficient j multiplies x_{i - m + j}
     c = signal.savgol_coeffs(int(window), int(order), deriv=1, delta=dt, use="dot")[m + 1:]
@@ -281,3 +271,14 @@ def smooth_derivative(
     if end_buffer_s is None:
         return np.array(d)
     return np.array(d[interior_mask(a.size, dt, end_buffer_s)])
+
+
+def _check_local_polynomial(dt: float, window: int, order: int) -> None:
+    """The local polynomial derivative's arguments (Eq. 24): a positive finite step, an odd
+    window of at least 3 points and an order below it."""
+    if not (np.isfinite(dt) and dt > 0.0):
+        raise ValueError("dt must be a positive finite number")
+    if int(window) != window or window < 3 or window % 2 == 0:
+        raise ValueError("window must be an odd integer >= 3")
+    if int(order) != order or not (1 <= order < window):
+        raise ValueError("order must be an integer with 1 <= order < window")
