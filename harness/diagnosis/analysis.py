@@ -258,16 +258,49 @@ def _withhold_in_turbulence(cands: list[Candidate]) -> None:
             c.reason = NOT_IN_GUSTS
 
 
+# The rate each surface mainly drives: a time skew of that rate's channel makes the surface
+# look late by the same amount.
+SURFACE_RATE = {"de": "q", "da": "p", "dr": "r"}
+
+
+def _kin_estimate(kin: KinematicResult, name: str) -> tuple[float, float] | None:
+    """A kinematic parameter's estimate and |t|, whether it entered the fit (its final value)
+    or not (its value when tried in the final model); None when it was not a candidate."""
+    if name in kin.selection.params:
+        return kin.selection.params[name], _t_of(kin, name)
+    term = next((t for t in kin.selection.terms if t.name == name), None)
+    return None if term is None else (term.estimate, abs(term.t))
+
+
+def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
+    """Deselect a control delay the kinematics can explain as a time skew of the rate its
+    surface drives (same sign, |t| >= :data:`AMBIGUOUS_T`, size within 2 standard errors or
+    30 %): a gyro that lags imitates an actuator that lags."""
+    name = f"skew_{SURFACE_RATE.get(c.channel, '')}"
+    found = _kin_estimate(kin, name)
+    if found is None:
+        return
+    skew, t = found
+    close = abs(skew - c.estimate) <= max(2.0 * c.std_error, 0.3 * abs(c.estimate))
+    if t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and close:
+        c.selected = False
+        c.reason = (f"entered, but not named: the kinematics show the {SURFACE_RATE[c.channel]} channel lagging by "
+                    f"{skew:.3f} s ({name}, t = {t:.1f}), which looks like this delay")
+
+
 def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
     """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
     channel they are built on (:data:`AMBIGUOUS_T`); the reason names the rival."""
     suspects: dict[str, tuple[str, float]] = {}
     for name, sp in kin.parameters.items():
-        if name in kin.selection.params and name.split("_", 1)[0] in AMBIGUOUS_KINDS:
-            t = _t_of(kin, name)
+        found = _kin_estimate(kin, name)
+        if found is not None and name.split("_", 1)[0] in AMBIGUOUS_KINDS:
+            t = found[1]
             if t >= AMBIGUOUS_T and t > suspects.get(sp.channel, ("", 0.0))[1]:
                 suspects[sp.channel] = (name, t)
     for c in cands:
+        if c.selected and c.effect == "control_delay":
+            _withhold_skewed_delay(c, kin)
         if not (c.selected and c.effect == "coefficient_error"):
             continue
         channel = cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
