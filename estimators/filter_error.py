@@ -47,8 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from estimators.output_error_models import (OutputErrorData, _per_parameter, affine_system, check_equation, model_spec,
-                                            output_error_data)
+from estimators.output_error_models import OutputErrorData, _per_parameter, affine_system, resolve_data
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit, collinearity
 from estimators.state_space import discretize, discretize_derivatives, expm_small, propagate, scan
@@ -138,13 +137,7 @@ class FilterError:
         """Estimate θ and the noise variances; ``cov`` the Cramér-Rao bound of (FE-3)."""
         from estimators.output_error import (COST_TOLERANCE, STEP_TOLERANCE, DivergenceError, OutputError,
                                              _check_information, _inverse)
-        if isinstance(source, OutputErrorData):
-            data = source
-            check_equation(model_spec(data.model), equation if equation is not None and equation.regressors else None)
-        else:
-            name = model_spec(self.model, equation).name
-            check_equation(model_spec(name), equation)
-            data = output_error_data(source, name, self.data)
+        data = resolve_data(source, None if isinstance(source, OutputErrorData) else self.model, equation, self.data)
         spec = data.spec
         oe = OutputError(model=spec.name, data=self.data).fit(data if isinstance(source, OutputErrorData) else source,
                                                             equation)

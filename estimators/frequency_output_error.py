@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from estimators.fourier import RIGID_BODY_UPPER_HZ, plain_dft
-from estimators.output_error_models import OutputErrorData, affine_system, check_equation, model_spec, output_error_data
+from estimators.output_error_models import OutputErrorData, affine_system, resolve_data
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit, collinearity
 from estimators.state_space import discretize, discretize_derivatives
@@ -90,13 +90,7 @@ class FrequencyOutputError:
         """Estimate the model's derivatives and the end-state changes Δx; ``cov`` the Cramér-Rao bound."""
         from estimators.output_error import (COST_TOLERANCE, STEP_TOLERANCE, OutputError, _check_information,
                                              _inverse, _Problem)
-        if isinstance(source, OutputErrorData):
-            data = source
-            check_equation(model_spec(data.model), equation if equation is not None and equation.regressors else None)
-        else:
-            name = model_spec(self.model, equation).name
-            check_equation(model_spec(name), equation)
-            data = output_error_data(source, name, self.data)
+        data = resolve_data(source, None if isinstance(source, OutputErrorData) else self.model, equation, self.data)
         spec = data.spec
         nd, n, nu = len(spec.derivatives), len(spec.states), len(spec.inputs)
         system = affine_system(spec, data.flight)

@@ -32,8 +32,8 @@ from estimators.equation_error import EquationErrorTime
 from estimators.least_squares import SingularRegressorsError, r_squared
 from estimators.dynamic_models import ManeuverData, ModelProtocol, maneuver_data
 from estimators.output_error_models import (AffineSystem, ModelSpec, OutputErrorData, affine_system,
-                                            check_equation, flight_constants, model_spec, output_error_data,
-                                            parameter_names, response, response_and_sensitivities)
+                                            flight_constants, model_spec, output_error_data, parameter_names,
+                                            resolve_data, response, response_and_sensitivities)
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit, collinearity
 from estimators.state_space import HOLDS, short_period_dimensional
@@ -332,16 +332,8 @@ class OutputError:
         if isinstance(source, (list, tuple)):
             raise ValueError("several maneuvers are fitted with a Model (estimators.dynamic_models); the built-in "
                              "models take one recording")
-        if isinstance(source, OutputErrorData):
-            name = self.model or source.model
-            if name != source.model:
-                raise ValueError(f"OutputError(model={self.model!r}) given {source.model!r} data")
-            check_equation(model_spec(name), equation if equation is not None and equation.regressors else None)
-            data = source
-        else:
-            name = model_spec(self.model, equation).name
-            check_equation(model_spec(name), equation)
-            data = output_error_data(source, name, self.data)
+        data = resolve_data(source, self.model, equation, self.data)
+        name = data.model
         spec = data.spec
         for i, u in enumerate(spec.inputs):
             if np.ptp(data.u[:, i]) == 0:

@@ -389,3 +389,24 @@ def _per_parameter(a: np.ndarray, T: np.ndarray) -> np.ndarray:
     """out[j, k] = T[j] a[k] for every parameter j as one matrix product: (K, c), (p, r, c) → (p, K, r)."""
     p, r, c = T.shape
     return (a @ T.transpose(2, 0, 1).reshape(c, p * r)).reshape(len(a), p, r).transpose(1, 0, 2)
+
+
+def resolve_data(source: "Recording | OutputErrorData", model: str | None, equation: Equation | None,
+                 options: DataOptions) -> OutputErrorData:
+    """The built-in model's data from a recording or given arrays, with the equation checked
+    against the model (:func:`check_equation`: regressors it does not have are refused).
+
+    Raises
+    ------
+    ValueError
+        When ``model`` names another model than the given data's, or the equation asks for
+        terms the model lacks.
+    """
+    if isinstance(source, OutputErrorData):
+        if model is not None and model != source.model:
+            raise ValueError(f"model {model!r} given {source.model!r} data")
+        check_equation(model_spec(source.model), equation if equation is not None and equation.regressors else None)
+        return source
+    name = model_spec(model, equation).name
+    check_equation(model_spec(name), equation)
+    return output_error_data(source, name, options)
