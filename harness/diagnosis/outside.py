@@ -33,7 +33,6 @@ from __future__ import annotations
 import json
 import math
 import traceback
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -43,6 +42,7 @@ from scipy import signal
 
 from harness.atomic import write_text_atomic
 from harness.diagnosis.gallery import StructuralMode, conceal
+from harness.diagnosis.sweep import run_resumable
 from harness.noise import ChannelNoise, NoiseModel, apply_noise
 from harness.noise_presets import WHITE_LEVELS
 from harness.recording_io import write_recording
@@ -562,16 +562,7 @@ def sweep(out: str | Path, names: list[str] | None = None, workers: int = 2) -> 
     """Run the outside sweep (the cases ``names``, default all) into ``out``; finished cases
     are read back, not run again."""
     out = Path(out)
-    chosen = [c for c in cases() if names is None or c.name in names]
-    if names is not None and len(chosen) != len(set(names)):
-        known = {c.name for c in cases()}
-        raise ValueError(f"no outside-sweep case {sorted(set(names) - known)}; see harness/diagnosis/outside.py")
-    todo = [c for c in chosen if not (out / "results" / f"{c.name}.json").is_file()]
-    if todo:
-        with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
-            for c, row in zip(todo, pool.map(run_case, todo, [out] * len(todo))):
-                print(f"{c.name}: {'error: ' + row['error'] if row.get('error') else 'done'}", flush=True)
-    rows = [json.loads((out / "results" / f"{c.name}.json").read_text()) for c in chosen]
+    chosen, rows = run_resumable(cases(), names, out, workers, run_case, "outside-sweep")
     write_text_atomic(out / "sweep.json", json.dumps(
         {"cases": [asdict(c) | {"effects": [e.describe() for e in c.effects]} for c in chosen],
          "conditions": {k: asdict(v) for k, v in CONDITIONS.items()}, "provenance": provenance(), "rows": rows,

@@ -205,20 +205,28 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def run_resumable(all_cases, names: list[str] | None, out: Path, workers: int, run, what: str):
+    """Select ``all_cases`` by name (all when ``names`` is None), run those without a result
+    file under ``out/results`` in a process pool (``run(case, out)`` writes it) and read every
+    chosen case's result back. Returns ``(chosen, rows)``; a rerun resumes."""
+    chosen = [c for c in all_cases if names is None or c.name in names]
+    if names is not None and len(chosen) != len(set(names)):
+        known = {c.name for c in all_cases}
+        raise ValueError(f"no {what} case {sorted(set(names) - known)}")
+    todo = [c for c in chosen if not (out / "results" / f"{c.name}.json").is_file()]
+    if todo:
+        with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+            for c, row in zip(todo, pool.map(run, todo, [out] * len(todo))):
+                error = row.get("error") if isinstance(row, dict) else None
+                print(f"{c.name}: {'error: ' + error if error else 'done'}", flush=True)
+    return chosen, [json.loads((out / "results" / f"{c.name}.json").read_text()) for c in chosen]
+
+
 def sweep(out: str | Path, names: list[str] | None = None, workers: int = 2) -> list[dict]:
     """Run the sweep (the cases ``names``, default all) into ``out``; finished cases are read
     back, not run again."""
     out = Path(out)
-    chosen = [c for c in cases() if names is None or c.name in names]
-    if names is not None and len(chosen) != len(set(names)):
-        known = {c.name for c in cases()}
-        raise ValueError(f"no sweep case {sorted(set(names) - known)}; see harness/diagnosis/sweep.py")
-    todo = [c for c in chosen if not (out / "results" / f"{c.name}.json").is_file()]
-    if todo:
-        with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
-            for c, _ in zip(todo, pool.map(run_case, todo, [out] * len(todo))):
-                print(f"{c.name}: done", flush=True)
-    rows = [json.loads((out / "results" / f"{c.name}.json").read_text()) for c in chosen]
+    chosen, rows = run_resumable(cases(), names, out, workers, run_case, "sweep")
     write_text_atomic(out / "sweep.json", json.dumps({"cases": [asdict(c) | {"effects": [e.describe() for e in
                                                                                           c.effects]}
                                                                 for c in chosen], "rows": rows}, indent=1,
