@@ -1,9 +1,11 @@
 """The ``sidbench`` command line.
 
-Each subcommand is a function ``cmd_<name>(args) -> int`` named here by module path and
-imported only when run, so that ``--help`` stays quick; the report-writing subcommands live in
-``reports.commands`` (the harness never imports the reports package, which sits to its right
-in the data flow). Errors the user can fix (a malformed recording, a trim that
+The command line is the composition root: it sits above every package it wires together, and
+it (this module, ``harness.commands``, ``harness.bench`` and ``harness.__main__``) is the one place
+that may import the reports package; nothing below imports it back (tests/test_architecture.py).
+Each subcommand is a function ``cmd_<name>(args) -> int``, its module imported only when it
+runs, so that ``--help`` stays quick; the report-writing subcommands live in ``reports.commands``.
+Errors the user can fix (a malformed recording, a trim that
 fails, a diverging flight, a bad option) print one message naming the cause and exit 2.
 """
 from __future__ import annotations
@@ -14,6 +16,27 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from harness.flying import AIRCRAFT_HELP, CONDITION_HELP, add_flight_options, add_noise_options
+
+
+def _commands():
+    """The harness's subcommands (each module below is imported only when a subcommand runs)."""
+    from harness import commands
+    return commands
+
+
+def _bench():
+    from harness import bench
+    return bench
+
+
+def _report_commands():
+    from reports import commands
+    return commands
+
+
+def _diagnosis_commands():
+    from harness.diagnosis import commands
+    return commands
 
 
 class _DefaultsFormatter(argparse.HelpFormatter):
@@ -49,7 +72,7 @@ def _parser() -> argparse.ArgumentParser:
     add_flight_options(f)
     add_noise_options(f)
     f.add_argument("--out", required=True, help="output recording: NAME.csv (+ NAME.meta.json) or NAME.parquet")
-    f.set_defaults(func="harness.commands:cmd_fly")
+    f.set_defaults(func=lambda a: _commands().cmd_fly(a))
 
     t = sub.add_parser("truth", help="truth derivatives of an aircraft at a flight condition",
                        description="Non-dimensional stability and control derivatives at trim, about "
@@ -64,7 +87,7 @@ def _parser() -> argparse.ArgumentParser:
     t.add_argument("--check-linearization", action="store_true",
                    help="also compare with jsbsim.FGLinearization and print the relative differences "
                         "(default: off)")
-    t.set_defaults(func="harness.commands:cmd_truth")
+    t.set_defaults(func=lambda a: _commands().cmd_truth(a))
 
     i = sub.add_parser("import", help="convert a SIDPAC .mat file, or a user's ASCII/CSV file with a column map, "
                                       "to the canonical recording format",
@@ -79,7 +102,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="column map (TOML) for a user's ASCII/CSV file (default: none: FILE is a SIDPAC .mat or a "
                         "canonical recording)")
     i.add_argument("--out", required=True, help="output recording (.csv or .parquet)")
-    i.set_defaults(func="harness.commands:cmd_import")
+    i.set_defaults(func=lambda a: _commands().cmd_import(a))
 
     e = sub.add_parser("estimate", help="estimate model parameters from a recording",
                        description="Fit one equation (dependent = sum of regressors + bias) by equation "
@@ -129,7 +152,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--report", default=None, metavar="DIR",
                    help="write DIR/report.html (self-contained): measured vs model, residual and its spectrum, "
                         "regressors, estimates with bounds and truth (default: none)")
-    e.set_defaults(func="harness.commands:cmd_estimate")
+    e.set_defaults(func=lambda a: _commands().cmd_estimate(a))
 
     c = sub.add_parser("campaign", help="run a Monte Carlo campaign and print its scores",
                        description="Run a campaign file (TOML; or the name of a built-in campaign: "
@@ -146,12 +169,12 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
     c.add_argument("--history", default=None, help="also keep the scores in this history folder")
     c.add_argument("--quiet", action="store_true", help="no progress display")
-    c.set_defaults(func="harness.commands:cmd_campaign")
+    c.set_defaults(func=lambda a: _commands().cmd_campaign(a))
 
     b = sub.add_parser("bench", help="measure and print the benchmark table",
                        description="Time the project's main operations on this machine and print them.")
     b.add_argument("--repeat", type=int, default=7, help="repetitions per row (the best is kept)")
-    b.set_defaults(func="harness.bench:cmd_bench")
+    b.set_defaults(func=lambda a: _bench().cmd_bench(a))
 
     d = sub.add_parser("demo", help="the main job: fly, print the truth, run a quick campaign, write a report",
                        description="Fly the seed's default maneuver (F-16, stabilator 2-1-1-2, 1 deg, 1 s "
@@ -160,7 +183,7 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="out", help="output folder (default: out)")
     d.add_argument("--realizations", type=int, default=100, help="realizations of the demo campaign (default 100)")
     d.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
-    d.set_defaults(func="reports.commands:cmd_demo")
+    d.set_defaults(func=lambda a: _report_commands().cmd_demo(a))
 
     g = sub.add_parser("diagnose", help="locate and name what a model leaves out of a recording, model it, "
                                         "show the fit improve",
@@ -176,7 +199,7 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--recording", required=True, help="identification recording (.csv beside .meta.json, or .parquet)")
     g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
     g.add_argument("--out", required=True, help="output folder")
-    g.set_defaults(func="harness.commands:cmd_diagnose")
+    g.set_defaults(func=lambda a: _commands().cmd_diagnose(a))
 
     gg = sub.add_parser("gallery", help="write the concealed-effect recordings (identification + validation)",
                         description="Fly the F-16 with one hidden effect per case, add the realistic noise layer "
@@ -184,7 +207,7 @@ def _parser() -> argparse.ArgumentParser:
     gg.add_argument("--out", default="out/gallery", help="output folder")
     gg.add_argument("--seed", type=int, default=1, help="noise seed of the identification maneuver (validation: +1)")
     gg.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
-    gg.set_defaults(func="harness.diagnosis.commands:cmd_gallery")
+    gg.set_defaults(func=lambda a: _diagnosis_commands().cmd_gallery(a))
 
     sw = sub.add_parser("diagnosis-sweep", help="score the diagnosis on concealed effects of every id, sizes and "
                                                 "maneuvers against the outside bar",
@@ -196,7 +219,7 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--out", default="out/sweep", help="output folder")
     sw.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
     sw.add_argument("--workers", type=int, default=2, help="processes (default 2)")
-    sw.set_defaults(func="harness.diagnosis.commands:cmd_sweep")
+    sw.set_defaults(func=lambda a: _diagnosis_commands().cmd_sweep(a))
 
     so = sub.add_parser("outside-sweep", help="score the diagnosis on flight-test-like recordings at other conditions "
                                               "and on a second aircraft (c172x)",
@@ -211,7 +234,7 @@ def _parser() -> argparse.ArgumentParser:
     so.add_argument("--out", default="out/outside-sweep", help="output folder")
     so.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
     so.add_argument("--workers", type=int, default=2, help="processes (default 2)")
-    so.set_defaults(func="harness.diagnosis.commands:cmd_outside_sweep")
+    so.set_defaults(func=lambda a: _diagnosis_commands().cmd_outside_sweep(a))
 
     r = sub.add_parser("report", help="turn campaign output into HTML, Markdown and JSON reports",
                        description="Write report.html (self-contained), report.md and report.json for a campaign "
@@ -220,7 +243,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--kind", default="campaign", choices=["campaign", "benchmark"],
                    help="campaign: one folder's report; benchmark: methods ranked over several folders")
     r.add_argument("--out", default=None, help="where to write (default: the first folder)")
-    r.set_defaults(func="reports.commands:cmd_report")
+    r.set_defaults(func=lambda a: _report_commands().cmd_report(a))
 
     n = sub.add_parser("nightly", help="run the nightly campaign, compare, gate, report",
                        description="Run the nightly campaign, append it to the history, compare it with the previous "
@@ -240,7 +263,7 @@ def _parser() -> argparse.ArgumentParser:
                         "(default: a local process pool)")
     n.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
     n.add_argument("--quiet", action="store_true", help="no progress display")
-    n.set_defaults(func="reports.commands:cmd_nightly")
+    n.set_defaults(func=lambda a: _report_commands().cmd_nightly(a))
 
     v = sub.add_parser("review-maneuvers", help="maneuver design review of candidate inputs",
                        description="Fly candidate inputs on an aircraft and condition, score them by Monte Carlo, "
@@ -264,7 +287,7 @@ def _parser() -> argparse.ArgumentParser:
                         "(default: a local process pool)")
     v.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
     v.add_argument("--quiet", action="store_true", help="no progress display")
-    v.set_defaults(func="reports.commands:cmd_review_maneuvers")
+    v.set_defaults(func=lambda a: _report_commands().cmd_review_maneuvers(a))
     for command in sub.choices.values():
         command.formatter_class = _DefaultsFormatter
     p.formatter_class = _DefaultsFormatter
@@ -290,11 +313,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = _parser().parse_args([a for a in argv if a != "--debug"])
     except BrokenPipeError:  # `sidbench x --help | head`
         return quiet_broken_pipe()
-    module, name = args.func.split(":")
-    import importlib
-
-    func = getattr(importlib.import_module(module), name)
-    return run_reporting_errors(func, args, args.command, debug=debug)
+    return run_reporting_errors(args.func, args, args.command, debug=debug)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""Subcommands of ``sidbench`` that fly, compute truth and convert recordings."""
+"""Subcommands of ``sidbench`` that fly, compute truth, convert recordings, estimate and run
+campaigns. Part of the command line, the composition root: it may import the reports package."""
 from __future__ import annotations
 
 import argparse
@@ -94,22 +95,6 @@ def cmd_import(args: argparse.Namespace) -> int:
     return 0
 
 
-def fly_default(out: Path) -> Path:
-    """Fly the seed's default maneuver, print its truth table, write the recording."""
-    from harness.recording_io import write_recording
-    from maneuvers.fly import FlightSpec, fly_maneuver, truth_table
-    from models.truth import Derivatives
-
-    spec = FlightSpec()
-    rec = fly_maneuver(spec)
-    truth = Derivatives.from_dict(rec.meta["truth"])
-    path = write_recording(rec, Path(out) / "f16_stabilator_2112.csv")
-    print(f"Flew {spec.describe()}.\n")
-    print(truth_table(truth))
-    print(f"\nRecording: {path.resolve()} (+ {path.with_suffix('.meta.json').name}), {rec.n} samples")
-    return path
-
-
 def _check_estimate_outputs(args: argparse.Namespace) -> None:
     """Refuse bad output paths before the fit (not after it was printed)."""
     from harness.atomic import _first_file_on_the_way
@@ -189,8 +174,8 @@ def _finish_estimate(args, rec, fit, time, regs, names, notes) -> None:
         write_text_atomic(args.csv, run.parameter_table().to_csv(index=False, float_format="%.17g"))
         print(f"wrote {args.csv}")
     if getattr(args, "report", None):
-        import importlib
-        html = importlib.import_module("reports.estimate_report").write_estimate_report(run, args.report)
+        from reports.estimate_report import write_estimate_report
+        html = write_estimate_report(run, args.report)
         print(f"wrote {html}")
 
 
@@ -251,11 +236,10 @@ def cmd_campaign(args: argparse.Namespace) -> int:
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
-    """``sidbench diagnose``: the diagnosis and its report (``reports.commands``, loaded by module path:
-    the harness never imports the reports package), with OUT marked incomplete until both are written."""
-    import importlib
-
+    """``sidbench diagnose``: the diagnosis and its report (``reports.commands``), with OUT marked
+    incomplete until both are written."""
     from harness.diagnosis.run import incomplete_marker
+    from reports.commands import cmd_diagnose as diagnose_and_report
 
     with incomplete_marker(Path(args.out)):
-        return int(importlib.import_module("reports.commands").cmd_diagnose(args) or 0)
+        return int(diagnose_and_report(args) or 0)

@@ -1,8 +1,8 @@
 """One ``sidbench estimate`` run as data: the fit, the options that produced it, the truth the
 recording carries, and the time histories a report shows (measured, model, residual, regressors).
 
-The report itself (``reports.estimate_report``) is loaded by module path from
-``harness.commands``: the harness never imports the reports package.
+The report itself (``reports.estimate_report``) is written by ``harness.commands``, part of the
+command line (the composition root); this module, below it, never imports the reports package.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Command-line options that define a flight, and turning them into a FlightSpec."""
+"""Command-line options that define a flight, turning them into a FlightSpec, and the default flight."""
 from __future__ import annotations
 
 import argparse
@@ -98,3 +98,21 @@ def spec_from_args(args: argparse.Namespace):
     return FlightSpec(input=signal, aircraft=resolve_aircraft(args.aircraft, args.variant), condition=args.condition,
                       duration_s=args.duration, sample_rate_hz=args.sample_rate, sim_rate_hz=args.sim_rate,
                       loop=parse_loop(args.loop))
+
+
+def fly_default(out: Path) -> Path:
+    """Fly the seed's default maneuver, print its truth table, write the recording."""
+    from pathlib import Path
+
+    from harness.recording_io import write_recording
+    from maneuvers.fly import FlightSpec, fly_maneuver, truth_table
+    from models.truth import Derivatives
+
+    spec = FlightSpec()
+    rec = fly_maneuver(spec)
+    truth = Derivatives.from_dict(rec.meta["truth"])
+    path = write_recording(rec, Path(out) / "f16_stabilator_2112.csv")
+    print(f"Flew {spec.describe()}.\n")
+    print(truth_table(truth))
+    print(f"\nRecording: {path.resolve()} (+ {path.with_suffix('.meta.json').name}), {rec.n} samples")
+    return path

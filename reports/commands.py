@@ -1,4 +1,4 @@
-"""Subcommands that write reports (registered in ``harness.cli`` by module path)."""
+"""Subcommands that write reports (registered in ``harness.cli``, the composition root)."""
 from __future__ import annotations
 
 import argparse
@@ -93,7 +93,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 def cmd_demo(args: argparse.Namespace) -> int:
     """Fly the default maneuver and print its truth, then run a quick campaign and report it."""
     from harness.campaign import load_campaign
-    from harness.commands import fly_default
+    from harness.flying import fly_default
     from harness.runner import run_campaign
     from harness.store import write_parquet
     from harness.studies import differentiation_study
