@@ -93,12 +93,3 @@ def format_scores(scores: pd.DataFrame, columns: list[str] | None = None, max_ro
     with pd.option_context("display.max_rows", max_rows, "display.width", 200, "display.max_columns", 30,
                            "display.float_format", lambda v: f"{v:.4g}"):
         return s[cols].to_string(index=False)
-
-
-def excursion_table(results: pd.DataFrame) -> pd.DataFrame:
-    """Per flight: the excursions from trim recorded by the campaign (method 'excursion')."""
-    ex = results[results["method"] == "excursion"]
-    if ex.empty:
-        return pd.DataFrame()
-    keys = ["aircraft", "variant", "condition", "maneuver", "loop"]
-    return ex.pivot_table(index=keys, columns="parameter", values="estimate", aggfunc="first").reset_index()

@@ -267,13 +267,6 @@ def crb_rows(common: dict, clean: Recording, noise_model, equations: tuple[Equat
     return rows
 
 
-def _crb(fn, rec, model, theta, R):
-    out = fn(rec, model, theta, R)
-    if isinstance(out, tuple):
-        return out
-    return out.cov, tuple(out.names)
-
-
 EXCURSIONS = ("max_dalpha_deg", "max_dbeta_deg", "max_dnz_g", "dV_fps", "max_dV_fps")
 
 

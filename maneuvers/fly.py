@@ -86,15 +86,6 @@ def _load_and_trim(spec: FlightSpec) -> tuple[jsbsim.FGFDMExec, TrimPoint, dict]
     return fdm, trim(fdm, spec.aircraft, cond), kwargs
 
 
-def fly_history(spec: FlightSpec) -> tuple[FlightHistory, TrimPoint]:
-    """Trim and fly ``spec``; the raw sampled histories and the trim point."""
-    fdm, tp, _ = _load_and_trim(spec)
-    hist = fly(fdm, spec.aircraft, tp, spec.input.deflections, spec.length_s,
-               sample_rate_hz=spec.sample_rate_hz, sim_rate_hz=spec.sim_rate_hz, loop=spec.loop,
-               turbulence=spec.turbulence, turbulence_seed=spec.turbulence_seed)
-    return hist, tp
-
-
 def fly_maneuver(spec: FlightSpec = FlightSpec()) -> Recording:
     """Fly ``spec`` and return a canonical recording with per-sample truth coefficients.
 

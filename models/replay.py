@@ -20,8 +20,6 @@ from models.trim import TrimError, TrimPoint, trim
 from models.truth import CoefficientProbe, central_differences, differencing_instance
 
 SURFACES = ("de", "da", "dr")
-# Recorded state names (canonical quantity) the aerodynamics are evaluated at.
-STATE_NAMES = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "h")
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ import math
 import re
 import struct
 import unicodedata
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import PurePath
 from typing import Any
@@ -31,7 +31,7 @@ __all__ = [
     "KINDS", "STATUSES", "HIGHLIGHT_CLASSES", "HTML_MAX_ROWS", "MARKDOWN_MAX_ROWS",
     "Table", "Section", "Report", "Cell", "TableView", "Anchors",
     "table_view", "anchors", "slugify", "format_number", "format_value", "json_value",
-    "jsonable", "png_size", "provenance_items", "iter_tables",
+    "jsonable", "png_size", "provenance_items",
 ]
 
 KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis", "estimate")
@@ -639,11 +639,3 @@ def provenance_items(provenance: Mapping[str, Any]) -> list[tuple[str, str]]:
             continue
         items.append((str(key).replace("_", " ").capitalize(), format_value(value)))
     return items
-
-
-def iter_tables(report: Report) -> Iterable[tuple[Section, Table, str]]:
-    """Every table with its section and id, in document order."""
-    ids = anchors(report)
-    for section, table_ids in zip(report.sections, ids.tables):
-        for table, table_id in zip(section.tables, table_ids):
-            yield section, table, table_id
