@@ -8,6 +8,7 @@ from pathlib import Path
 import jsbsim
 
 from models.jsbsim_root import aircraft_xml, cached_root, engine_root, package_root, strip_io
+from models.errors import UserError
 
 VARIANTS = ("nominal", "exact-truth", "unstable")
 MODELS = ("f16", "737", "dhc6")
@@ -45,6 +46,10 @@ TRIM_MOMENT_PROPERTIES: dict[str, str] = {
     ax: f"external_reactions/sidbench-trim-{ax}/magnitude-lbsft" for ax in "lmn"}
 
 
+class AircraftError(UserError):
+    """An unknown aircraft or variant, or an aircraft XML JSBSim cannot fly as asked."""
+
+
 @dataclass(frozen=True)
 class Aircraft:
     """An aircraft model and variant.
@@ -77,16 +82,16 @@ class Aircraft:
 
     def __post_init__(self) -> None:
         if self.model not in MODELS and not is_xml_model(self.model):
-            raise ValueError(f"unknown aircraft {self.model!r}; choose one of {MODELS} or give the path "
+            raise AircraftError(f"unknown aircraft {self.model!r}; choose one of {MODELS} or give the path "
                              "of a JSBSim aircraft XML (<name>.xml)")
         if is_xml_model(self.model):
             if not Path(self.model).is_file():
-                raise ValueError(f"no JSBSim aircraft file {self.model!r}")
+                raise AircraftError(f"no JSBSim aircraft file {self.model!r}")
             if self.variant != "nominal":
-                raise ValueError(f"an aircraft given by path flies as it is: variant {self.variant!r} "
+                raise AircraftError(f"an aircraft given by path flies as it is: variant {self.variant!r} "
                                  "is only built for the project's models")
         if self.variant not in VARIANTS:
-            raise ValueError(f"unknown variant {self.variant!r}; choose one of {VARIANTS}")
+            raise AircraftError(f"unknown variant {self.variant!r}; choose one of {VARIANTS}")
 
     @property
     def surfaces(self) -> dict[str, str]:
@@ -172,7 +177,7 @@ def xml_surface_properties(model: str) -> dict[str, str]:
     for s, props in SURFACE_CANDIDATES.items():
         found = [p for p in props if p in read]
         if not found:
-            raise ValueError(f"{model}: its aerodynamics read none of {props}, so the {s} input has "
+            raise AircraftError(f"{model}: its aerodynamics read none of {props}, so the {s} input has "
                              "nowhere to go (the project drives these surface properties directly)")
         out[s] = found[0]
     return out
@@ -243,7 +248,7 @@ def nominal_tree(model: str) -> ET.ElementTree:
         try:
             return strip_io(ET.parse(model_xml(model)))
         except ET.ParseError as exc:
-            raise ValueError(f"{model} is not a readable JSBSim aircraft XML: {exc}") from exc
+            raise AircraftError(f"{model} is not a readable JSBSim aircraft XML: {exc}") from exc
     return strip_io(aircraft_xml(PACKAGE_NAMES[model]))
 
 
@@ -254,7 +259,7 @@ def nominal_root(model: str) -> tuple[Path | None, str]:
     if model == "737":
         return cached_root("737", strip_io(aircraft_xml("737")), model_xml(model)), "737"
     if is_xml_model(model) and (missing := missing_files(model)):
-        raise ValueError(f"{model} names files JSBSim will not find: {'; '.join(missing)}")
+        raise AircraftError(f"{model} names files JSBSim will not find: {'; '.join(missing)}")
     if model == "dhc6" or is_xml_model(model):
         name = PACKAGE_NAMES.get(model) or Path(model).stem
         return cached_root(name, nominal_tree(model), model_xml(model)), name

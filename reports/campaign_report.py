@@ -1,39 +1,102 @@
-"""The report of any campaign: scores, the seed's figures, and provenance."""
+"""The report of any campaign: what it found first (the largest biases, coverage failures and
+the method comparison), then what it flew, the scores, the seed's figures and provenance."""
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
 from reports import figures as F
+from reports.campaign_setup import read_setup
+from reports.findings import COVERAGE_BAND, Findings, case_columns, find, status_of
+from reports.lead import efficiency_note, findings_section, lead_lines, setup_section, status_note
 from reports.load import CampaignOutput, provenance
 from reports.render import Report, Section, Table
 
-SCORE_COLUMNS = ["noise", "maneuver", "method", "errors", "parameter", "n", "truth", "mean", "bias_pct", "bias_z",
-                 "std", "rmse", "se_ratio", "coverage", "coverage_lo", "coverage_hi", "efficiency", "time_s"]
 MAX_TABLE_ROWS = 300
+SE_RATIO_BAND: tuple[float, float] = (0.8, 1.25)
+"""Standard-error ratios counted honest enough not to flag (a 25 % error either way)."""
+GATE_KEYS: tuple[str, ...] = ("noise", "method", "errors", "maneuver", "parameter")
+"""The columns that name a gated cell in the nightly gate table."""
+_SCORE_COLUMNS = {"method": "method", "errors": "errors", "parameter": "parameter", "truth": "truth",
+                  "bias_pct": "bias %", "bias_z": "bias z", "rmse": "RMSE", "se_ratio": "SE ratio",
+                  "coverage": "coverage"}
+_SUMMARY_COLUMNS = {"noise": "noise", "method": "method", "errors": "errors", "parameters": "parameters",
+                    "median_coverage": "median coverage", "median_abs_bias_z": "median |bias z|",
+                    "worst_abs_bias_z": "worst |bias z|", "median_rel_rmse_pct": "median relative RMSE %",
+                    "median_se_ratio": "median SE ratio", "mean_time_ms": "time per estimate ms"}
 
 
-def score_table(scores: pd.DataFrame, title: str = "Scores", caption: str = "") -> Table:
-    """Scores with the cells that break a claim highlighted: |bias| beyond 3 Monte Carlo
-    standard errors, coverage whose 95 % interval excludes 0.95, standard-error ratios outside
-    [0.8, 1.25]."""
-    s = scores.reset_index(drop=True)
-    cols = [c for c in SCORE_COLUMNS if c in s.columns and (c not in ("maneuver",) or s[c].nunique() > 1)]
-    frame = s[cols].head(MAX_TABLE_ROWS).reset_index(drop=True)
+def _failed_cells(gates: pd.DataFrame | None, kind: str) -> set[tuple]:
+    """Keys (:data:`GATE_KEYS`) of the cells that failed a gate of ``kind``."""
+    if gates is None or gates.empty:
+        return set()
+    g = gates[(gates["kind"] == kind) & ~gates["passed"].astype(bool)]
+    return {tuple(r[k] for k in GATE_KEYS) for _, r in g.iterrows()}
+
+
+def _score_frame(s: pd.DataFrame) -> pd.DataFrame:
+    """The columns that fit a 1280 px page: the varying case columns, method, errors, parameter,
+    truth, bias, RMSE, SE ratio, coverage with its interval, and efficiency when there is one."""
+    cases = [c for c in case_columns(s) if c in s]
+    frame = s[cases + [c for c in _SCORE_COLUMNS if c in s]].rename(columns=_SCORE_COLUMNS)
+    if {"coverage_lo", "coverage_hi"} <= set(s):
+        frame["95 % interval"] = [f"[{lo:.2f}, {hi:.2f}]" if np.isfinite(lo) and np.isfinite(hi) else "—"
+                                  for lo, hi in zip(s["coverage_lo"], s["coverage_hi"])]
+    if "efficiency" in s and np.isfinite(s["efficiency"].astype(float)).any():
+        frame["efficiency"] = s["efficiency"]
+    return frame
+
+
+def _highlights(s: pd.DataFrame, bias_limit: float, gates: pd.DataFrame | None) -> tuple:
+    """Red: a finding (bias beyond the limit, coverage interval outside the band), or with gates
+    a gate failure only; amber: a departure from nominal that is not a failure (or not gated)."""
+    gated = gates is not None
+    failed_bias, failed_cov = _failed_cells(gates, "bias"), _failed_cells(gates, "coverage")
+    lo_band, hi_band = COVERAGE_BAND
     hl = []
-    for i, r in frame.iterrows():
-        if np.isfinite(r.get("bias_z", np.nan)) and abs(r["bias_z"]) > 3:
-            hl.append((i, "bias_z", "bad"))
-        if np.isfinite(r.get("coverage_lo", np.nan)) and (r["coverage_hi"] < 0.95 or r["coverage_lo"] > 0.95):
-            hl.append((i, "coverage", "bad" if abs(r["coverage"] - 0.95) > 0.1 else "warn"))
-        if np.isfinite(r.get("se_ratio", np.nan)) and not 0.8 <= r["se_ratio"] <= 1.25:
-            hl.append((i, "se_ratio", "warn"))
-    note = f" Showing the first {MAX_TABLE_ROWS} of {len(s)} rows; every number is in the JSON report." \
-        if len(s) > MAX_TABLE_ROWS else ""
-    return Table(title, frame, (caption or "One row per cell (noise, method, errors) and parameter. Red: |bias| "
-                                "over 3 Monte Carlo standard errors or coverage far from 0.95; amber: standard-error "
-                                "ratio outside [0.8, 1.25] or coverage's interval excluding 0.95.") + note,
-                 tuple(hl))
+    for i, r in s.iterrows():
+        key = tuple(r.get(k) for k in GATE_KEYS)
+        z, lo, hi = (float(r.get(k, np.nan)) for k in ("bias_z", "coverage_lo", "coverage_hi"))
+        if np.isfinite(z) and abs(z) > bias_limit:
+            hl.append((i, "bias z", "bad" if not gated or key in failed_bias else "warn"))
+        if np.isfinite(lo) and np.isfinite(hi) and (hi < 0.95 or lo > 0.95):
+            outside = hi < lo_band or lo > hi_band
+            hl.append((i, "coverage", "bad" if (key in failed_cov if gated else outside) else "warn"))
+        ratio = float(r.get("se_ratio", np.nan))
+        if np.isfinite(ratio) and not SE_RATIO_BAND[0] <= ratio <= SE_RATIO_BAND[1]:
+            hl.append((i, "SE ratio", "warn"))
+    return tuple(hl)
+
+
+def score_table(scores: pd.DataFrame, bias_limit: float, gates: pd.DataFrame | None = None,
+                title: str = "Scores") -> Table:
+    """Scores with the cells that break a claim highlighted (see :func:`_highlights`).
+
+    Parameters
+    ----------
+    scores : DataFrame
+        The score rows (parameters with a truth).
+    bias_limit : float
+        |bias_z| beyond which a bias is a finding (:attr:`reports.findings.Findings.bias_limit`).
+    gates : DataFrame, optional
+        The nightly gate table; with it only gate failures are red, other departures amber.
+    """
+    s = scores.reset_index(drop=True).head(MAX_TABLE_ROWS)
+    frame = _score_frame(s)
+    n = sorted({int(x) for x in scores["n"].dropna()}) if "n" in scores else []
+    lo, hi = COVERAGE_BAND
+    red = ("Red: a gate failure (the other cells are not gated: amber at most)" if gates is not None else
+           f"Red: |bias| beyond {bias_limit:.2f} Monte Carlo standard errors or a coverage interval wholly "
+           f"outside [{lo:.2f}, {hi:.2f}]")
+    caption = (f"One row per cell and parameter ({'/'.join(map(str, n)) or '?'} realizations). {red}; amber: "
+               f"coverage interval excluding 0.95, standard-error ratio outside [{SE_RATIO_BAND[0]}, "
+               f"{SE_RATIO_BAND[1]}], or a departure not gated.")
+    note = efficiency_note(scores)
+    if note:
+        caption += " " + note
+    if len(scores) > MAX_TABLE_ROWS:
+        caption += f" Showing the first {MAX_TABLE_ROWS} of {len(scores)} rows; every number is in the JSON report."
+    return Table(title, frame, caption, _highlights(s, bias_limit, gates))
 
 
 def method_summary(scores: pd.DataFrame) -> pd.DataFrame:
@@ -49,32 +112,34 @@ def method_summary(scores: pd.DataFrame) -> pd.DataFrame:
                  mean_time_ms=("time_s", lambda x: 1e3 * np.nanmean(x))).reset_index()
 
 
+def summary_table(scores: pd.DataFrame, bias_limit: float) -> Table:
+    """:func:`method_summary` with short headings, the worst bias beyond the limit in red."""
+    ms = method_summary(scores)
+    hl = tuple((i, "worst |bias z|", "bad") for i, z in enumerate(ms["worst_abs_bias_z"])
+               if np.isfinite(z) and z > bias_limit)
+    return Table("Methods", ms.rename(columns=_SUMMARY_COLUMNS),
+                 "Medians over the parameters of each cell: median |bias z| near 1 and median coverage near 0.95 mean "
+                 "unbiased estimates with honest bounds.", hl)
+
+
 def summary_lines(out: CampaignOutput) -> list[str]:
-    s = out.truth_scores
-    m = out.meta
-    lines = [f"{m['campaign']['name']}: {m['campaign']['cells']} cells x {m['campaign']['realizations']} realizations, "
-             f"{m.get('estimates', len(out.results))} estimates in {m.get('wall_s', float('nan')):.1f} s on {m.get('executor')}."]
-    if not s.empty:
-        ms = method_summary(s)
-        for _, r in ms.sort_values("median_abs_bias_z").iterrows():
-            lines.append(f"{r['method']} ({r['errors']}, {r['noise']}): median coverage {r['median_coverage']:.2f}, "
-                         f"worst |bias| {r['worst_abs_bias_z']:.1f} Monte Carlo standard errors, "
-                         f"median relative RMSE {r['median_rel_rmse_pct']:.1f} %.")
-            if len(lines) >= 9:
-                break
-    return lines
+    """The lead lines of the campaign's report (see :func:`reports.lead.lead_lines`)."""
+    return lead_lines(out, find(out.truth_scores), read_setup(out.meta))
 
 
 def _figs(*items):
     return tuple(f for f in items if f is not None)
 
 
-def campaign_sections(out: CampaignOutput) -> list[Section]:
+def campaign_sections(out: CampaignOutput, findings: Findings | None = None,
+                      gates: pd.DataFrame | None = None) -> list[Section]:
+    """The sections after the lead: methods at a glance, scores and figures, collinearity,
+    model fit, maneuvers, differentiation."""
     s = out.truth_scores
-    sections = [Section("Methods at a glance", ("Medians over the parameters of each cell.",),
-                        (Table("Methods", method_summary(s), "median_abs_bias_z near 1 and median_coverage near 0.95 "
-                               "mean unbiased estimates with honest bounds."),) if not s.empty else ()),
-                Section("Accuracy and honesty", (), (score_table(s),),
+    f = findings if findings is not None else find(s)
+    eff = efficiency_note(s)
+    sections = [Section("Methods at a glance", (), (summary_table(s, f.bias_limit),) if not s.empty else ()),
+                Section("Accuracy and honesty", (eff,) if eff else (), (score_table(s, f.bias_limit, gates),),
                         _figs(F.fig_bias(s), F.fig_coverage(s), F.fig_se_ratio(s), F.fig_efficiency(s),
                               F.fig_scatter(out.results, s)))]
     if "max_corr" in s and s["loop"].nunique() > 2:
@@ -97,11 +162,29 @@ def campaign_sections(out: CampaignOutput) -> list[Section]:
     return sections
 
 
+def _lead_numbers(f: Findings) -> dict:
+    """The findings for machines: the limit, the biases, the coverage failures, the comparison."""
+    def rows(frame: pd.DataFrame, columns: list[str]) -> list[dict]:
+        cols = [c for c in columns if c in frame]
+        return frame[cols].replace({np.nan: None}).to_dict(orient="records") if not frame.empty else []
+    keys = list(f.cases) + ["method", "parameter", "truth", "bias_pct", "bias_z"]
+    return {"bias_limit": f.bias_limit, "bias_tests": len(f.tests), "coverage_band": list(COVERAGE_BAND),
+            "cells_with_coverage": f.cells_with_coverage, "min_realizations": f.min_n,
+            "biases": rows(f.biases, keys), "comparison": rows(f.comparison, keys),
+            "coverage_failures": rows(f.coverage, list(f.cases) + ["method", "errors", "parameter", "coverage",
+                                                                   "coverage_lo", "coverage_hi", "se_ratio"])}
+
+
 def campaign_report(out: CampaignOutput) -> Report:
-    """The report of a campaign's output folder."""
+    """The report of a campaign's output folder; its status is ``'findings'`` when a bias or a
+    coverage failure was found (:func:`reports.findings.status_of`)."""
     s = out.truth_scores
-    numbers = {"scores": out.scores.replace({np.nan: None}).to_dict(orient="records"),
+    f = find(s)
+    setup = read_setup(out.meta)
+    numbers = {"lead": _lead_numbers(f),
+               "scores": out.scores.replace({np.nan: None}).to_dict(orient="records"),
                "methods": method_summary(s).replace({np.nan: None}).to_dict(orient="records") if not s.empty else []}
+    sections = [findings_section(f), setup_section(out, setup)] + campaign_sections(out, f)
     return Report(title=f"Campaign report: {out.meta['campaign']['name']}", kind="campaign",
-                  provenance=provenance(out.meta), summary=tuple(summary_lines(out)),
-                  sections=tuple(campaign_sections(out)), numbers=numbers)
+                  provenance=provenance(out.meta), summary=tuple(lead_lines(out, f, setup)),
+                  sections=tuple(sections), numbers=numbers, status=status_of(f), status_note=status_note(f))

@@ -3,7 +3,9 @@
 No external CSS, JavaScript, fonts or images: the style sheet is inline and figures are
 ``data:image/png;base64`` images, so the file can be mailed, archived or attached to a CI run
 and still reads the same. All text is escaped. The page is sized for a laptop screen
-(content at most ~1100 px wide) and prints cleanly (``@media print``).
+(content at most ~1100 px wide; column headings wrap so that tables fit a 1280 px window) and
+prints cleanly (``@media print``). The header leads with the status badge (and why) and the
+summary lines, then the provenance.
 
 Ids are stable for the same report: ``section-<slug>``, ``table-<slug>`` (from the table
 title) and ``figure-<slug>`` (from the figure name); see :func:`reports.render.anchors`.
@@ -65,7 +67,8 @@ code, .mono { font-family: ui-monospace, SFMono-Regular, Menlo, Consolas, "Liber
 }
 .badge-ok { background: var(--ok-bg); }
 .badge-fail { background: var(--fail-bg); }
-.badge-findings { background: var(--warn-bg); color: var(--warn-fg); }
+.badge-findings { background: var(--warn-bg); color: var(--warn-fg); border: 1px solid #d4a72c; }
+.status-note { color: var(--muted); font-size: .95rem; }
 .provenance {
   display: grid; grid-template-columns: max-content 1fr; gap: .15rem 1rem; margin: 0 0 1rem;
   padding: .7rem 1rem; background: var(--zebra); border-radius: 6px; font-size: .9rem;
@@ -85,10 +88,10 @@ code, .mono { font-family: ui-monospace, SFMono-Regular, Menlo, Consolas, "Liber
 table { border-collapse: collapse; width: 100%; font-size: .9rem;
         font-variant-numeric: tabular-nums; }
 caption { caption-side: top; text-align: left; font-weight: 600; padding: .5rem .6rem; }
-th, td { padding: .3rem .9rem; border-bottom: 1px solid var(--line); text-align: left;
+th, td { padding: .3rem .6rem; border-bottom: 1px solid var(--line); text-align: left;
          vertical-align: top; }
 thead th { position: sticky; top: 0; background: #eef1f4; border-bottom: 2px solid var(--line);
-           white-space: nowrap; }
+           overflow-wrap: normal; hyphens: manual; }
 tbody tr:nth-child(even) { background: var(--zebra); }
 tbody tr:last-child td, tbody tr:last-child th { border-bottom: 0; }
 tbody th { font-weight: 600; }
@@ -207,6 +210,7 @@ def html_text(report: Report, *, max_rows: int | None = HTML_MAX_ROWS) -> str:
     """
     ids = anchors(report)
     status = report.status
+    note_title = f' title="{_e(report.status_note)}"' if report.status_note else ""
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en">',
@@ -223,10 +227,15 @@ def html_text(report: Report, *, max_rows: int | None = HTML_MAX_ROWS) -> str:
         '<div class="titlebar">',
         f"<h1>{_e(report.title)}</h1>",
         f'<span class="badge badge-{_e(status)}" id="status" '
-        f'aria-label="status: {_e(status)}">{_e(status.upper())}</span>',
-        "</div>",
-        f'<p class="kind">{_e(_KIND_LABELS.get(report.kind, report.kind))}</p>',
+        f'aria-label="status: {_e(status)}"{note_title}>{_e(status.upper())}</span>',
     ]
+    if report.status_note:
+        parts.append(f'<span class="status-note" id="status-note">{_e(report.status_note)}</span>')
+    parts += ["</div>", f'<p class="kind">{_e(_KIND_LABELS.get(report.kind, report.kind))}</p>']
+    if report.summary:  # the lead: what matters first, before where it came from
+        parts.append('<ul class="summary" id="summary">')
+        parts += [f"<li>{_e(line)}</li>" for line in report.summary]
+        parts.append("</ul>")
     items = provenance_items(report.provenance)
     if items:
         parts.append('<dl class="provenance" id="provenance">')
@@ -234,10 +243,6 @@ def html_text(report: Report, *, max_rows: int | None = HTML_MAX_ROWS) -> str:
             mono = ' class="mono"' if label in ("SHA-256", "Commit", "File") else ""
             parts.append(f"<dt>{_e(label)}</dt><dd{mono}>{_e(text)}</dd>")
         parts.append("</dl>")
-    if report.summary:
-        parts.append('<ul class="summary" id="summary">')
-        parts += [f"<li>{_e(line)}</li>" for line in report.summary]
-        parts.append("</ul>")
     parts.append("</header>")
     if report.sections:
         parts.append('<nav class="toc" aria-label="Contents"><h2>Contents</h2><ol>')

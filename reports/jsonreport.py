@@ -2,7 +2,7 @@
 
 Layout::
 
-    {"title", "kind", "status", "provenance", "summary", "numbers",
+    {"title", "kind", "status", "status_note", "provenance", "summary", "numbers",
      "sections": [{"title", "paragraphs",
                    "tables": [{"title", "caption", "columns", "rows", "total_rows"}],
                    "figures": [{"name", "caption"}]}]}
@@ -60,6 +60,7 @@ def report_dict(report: Report, *, max_rows: int | None = HTML_MAX_ROWS) -> dict
         "title": report.title,
         "kind": report.kind,
         "status": report.status,
+        "status_note": report.status_note,
         "provenance": jsonable(report.provenance),
         "summary": list(report.summary),
         "numbers": jsonable(report.numbers),

@@ -1,6 +1,6 @@
 """A short Markdown summary of a report, for CI logs and pull requests.
 
-Title, status, provenance in a line or two, the summary lines, and each section's first table
+Title, status (and why), the summary lines, provenance in a line or two, and each section's first table
 (its first :data:`reports.render.MARKDOWN_MAX_ROWS` rows) as a GitHub table. No images: the
 figures and the other tables are in the HTML report, which the text points to.
 """
@@ -60,13 +60,14 @@ def markdown_text(report: Report, *, html_name: str | None = None,
     """
     status = {"ok": "OK", "findings": "FINDINGS"}.get(report.status, "FAIL")
     icon = {"ok": "✅", "findings": "⚠️"}.get(report.status, "❌")
+    note = f" ({_md(report.status_note)})" if report.status_note else ""
     lines = [f"# {_md(report.title)}", "",
-             f"**Status: {icon} {status}** · {_md(report.kind)} report", ""]
+             f"**Status: {icon} {status}**{note} · {_md(report.kind)} report", ""]
+    if report.summary:
+        lines += [f"- {_md(line)}" for line in report.summary] + [""]
     provenance = _provenance_lines(report)
     if provenance:
         lines += [line + "  " for line in provenance[:-1]] + [provenance[-1], ""]
-    if report.summary:
-        lines += [f"- {_md(line)}" for line in report.summary] + [""]
     for section in report.sections:
         if not section.tables:
             continue

@@ -37,7 +37,8 @@ __all__ = [
 KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis", "estimate")
 """The kinds of report the project writes."""
 STATUSES: tuple[str, ...] = ("ok", "fail", "findings")
-"""Report outcomes (the nightly gate's verdict; ``ok`` for reports without a gate)."""
+"""Report outcomes: ``fail`` when a gate failed, ``findings`` when biases, coverage failures or
+effects were found, ``ok`` otherwise (see :func:`reports.findings.status_of`)."""
 HIGHLIGHT_CLASSES: tuple[str, ...] = ("bad", "good", "warn")
 """CSS classes a highlighted table cell may carry."""
 HTML_MAX_ROWS: int = 300
@@ -186,8 +187,11 @@ class Report:
     numbers : Mapping
         Every number shown, for machines (written whole to the JSON report).
     status : str, optional
-        ``'ok'`` (default), ``'fail'`` (the nightly gate's outcome) or ``'findings'`` (a
-        diagnosis that found effects: not a failure, not "OK" either).
+        ``'ok'`` (default), ``'fail'`` (a gate failed) or ``'findings'`` (a diagnosis that
+        found effects, a campaign with biases or coverage failures: not a failure, not "OK"
+        either).
+    status_note : str, optional
+        Why the status is what it is, in a few words (shown beside the badge).
 
     Notes
     -----
@@ -202,6 +206,7 @@ class Report:
     sections: tuple[Section, ...]
     numbers: Mapping[str, Any]
     status: str = "ok"
+    status_note: str = ""
 
     def __post_init__(self) -> None:
         if not isinstance(self.title, str):
@@ -210,6 +215,8 @@ class Report:
             raise ValueError(f"Report kind {self.kind!r} is not one of {KINDS}")
         if self.status not in STATUSES:
             raise ValueError(f"Report status {self.status!r} is not one of {STATUSES}")
+        if not isinstance(self.status_note, str):
+            raise TypeError("Report status_note must be a string")
         for name in ("provenance", "numbers"):
             value = getattr(self, name)
             if not isinstance(value, Mapping):

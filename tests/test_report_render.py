@@ -223,7 +223,7 @@ def test_json_layout_nulls_and_numpy(written):
     text = paths["json"].read_text(encoding="utf-8")
     assert not re.search(r"[:,\[]\s*-?(NaN|Infinity)\b", text)
     data = json.loads(text)
-    assert set(data) == {"title", "kind", "status", "provenance", "summary", "numbers",
+    assert set(data) == {"title", "kind", "status", "status_note", "provenance", "summary", "numbers",
                          "sections"}
     assert data["status"] == "fail" and data["kind"] == "nightly"
     assert data["numbers"] == {"Cm_alpha": {"truth": -0.0813, "estimate": None},
