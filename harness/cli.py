@@ -39,6 +39,13 @@ def _diagnosis_commands():
     return commands
 
 
+def _calibrate(args: argparse.Namespace) -> int:
+    """``sidbench calibrate``: the calibration (harness) and its report (reports), wired here."""
+    from harness.calibrate.command import cmd_calibrate
+    from reports.calibration_report import write_calibration_report
+    return cmd_calibrate(args, write_calibration_report)
+
+
 class _DefaultsFormatter(argparse.HelpFormatter):
     """Every option's help ends with its default, unless the text already states it."""
 
@@ -200,6 +207,35 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
     g.add_argument("--out", required=True, help="output folder")
     g.set_defaults(func=lambda a: _commands().cmd_diagnose(a))
+
+    cal = sub.add_parser("calibrate", help="JSBSim in the loop: calibrate an aircraft XML to flight recordings by "
+                                           "output error",
+                         description="Fly the JSBSim aircraft with the recorded surfaces from each recording's start "
+                                     "and fit named adjustments of its own XML (a scale or increment of any "
+                                     "aerodynamic <function>, an added term of the diagnosis's vocabulary, a surface "
+                                     "delay, a mass or reference-point change) by output error: Gauss-Newton on "
+                                     "finite-difference sensitivities from perturbed flights in parallel. Writes "
+                                     "OUT/calibration.json, OUT/model/ (the calibrated XML, which flies in stock "
+                                     "JSBSim), OUT/series/ and OUT/report.html.")
+    cal.add_argument("--model", required=True, help="aircraft: f16, 737, dhc6, or the path of a JSBSim aircraft XML")
+    cal.add_argument("--recording", required=True, action="append",
+                     help="identification recording (.csv beside .meta.json, .parquet or SIDPAC .mat); repeatable")
+    cal.add_argument("--validation", action="append", default=None,
+                     help="recording the calibrated model is only flown on (a prediction); repeatable (default: none)")
+    cal.add_argument("--parameters", required=True,
+                     help="comma list: FUNCTION:scale or FUNCTION:increment (e.g. aero/coefficient/Cnb:scale), a "
+                          "vocabulary term (Cm_alphadot, Cn_beta, Cl_beta_abs, ...), tau_de|tau_da|tau_dr, iyy:scale, "
+                          "cg_x:increment ...; NAME=VALUE sets the start")
+    cal.add_argument("--out", required=True, help="output folder")
+    cal.add_argument("--outputs", default=None,
+                     help="comma list of channels matched (default: those of alpha,beta,p,q,r,phi,theta,V,ax,ay,az "
+                          "the recording has)")
+    cal.add_argument("--mass", choices=("model", "recording"), default="model",
+                     help="fly the model with its own mass properties or with the recording's (first sample) "
+                          "(default: model)")
+    cal.add_argument("--workers", type=int, default=2, help="processes flying the perturbed flights (default 2)")
+    cal.add_argument("--max-iterations", type=int, default=20, help="Gauss-Newton iterations at most (default 20)")
+    cal.set_defaults(func=_calibrate)
 
     gg = sub.add_parser("gallery", help="write the concealed-effect recordings (identification + validation)",
                         description="Fly the F-16 with one hidden effect per case, add the realistic noise layer "

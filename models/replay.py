@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -51,10 +52,16 @@ def trim_at(aircraft: Aircraft, ic: InitialCondition, refs: Mapping[str, float] 
 
 def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Mapping[str, np.ndarray], *,
            refs: Mapping[str, float] | None = None, sim_rate_hz: float = 120.0,
-           wind_ned_fps: Mapping[str, np.ndarray] | None = None) -> tuple[FlightHistory, TrimPoint]:
+           wind_ned_fps: Mapping[str, np.ndarray] | None = None, root: Path | None = None,
+           name: str | None = None, delays_s: Mapping[str, float] | None = None
+           ) -> tuple[FlightHistory, TrimPoint]:
     """Fly ``aircraft`` from trim at ``ic`` with the recording's surface motions.
 
     ``wind_ned_fps`` flies it through a given wind history (:func:`models.flight.fly`).
+    ``root``/``name`` load another XML of the same aircraft (a calibrated copy,
+    :mod:`models.calibration_xml`) while ``aircraft`` still says how to trim and fly it.
+    ``delays_s`` (surface -> s) feeds the aerodynamics δ(t − τ): the recorded motion shifted
+    by τ, linearly interpolated, so the response is continuous in τ.
     Each surface moves by the recorded change from its first sample (linear interpolation
     between samples onto the simulation frames), about the model's own trim position: a
     model that needs another trim deflection still starts in equilibrium.
@@ -65,14 +72,17 @@ def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Ma
         When the model cannot trim there or diverges while replaying.
     """
     cond, kwargs = _instance(aircraft, ic, refs)
+    if root is not None:
+        kwargs = {"root": root, "name": name}
     fdm = load_fdm(aircraft, 1 / 120, **kwargs)
     tp = trim(fdm, aircraft, cond)
     t = np.asarray(t, dtype=float)
     moves = {s: np.asarray(x, dtype=float) - float(x[0]) for s, x in surfaces.items() if s in SURFACES}
     rel = t - t[0]
+    late = dict(delays_s or {})
 
     def deflections(tf: np.ndarray) -> dict[str, np.ndarray]:
-        return {s: np.interp(tf, rel, x) for s, x in moves.items()}
+        return {s: np.interp(tf - late.get(s, 0.0), rel, x) for s, x in moves.items()}
 
     dt = float(np.median(np.diff(t)))
     hist = fly(fdm, aircraft, tp, deflections, rel[-1], sample_rate_hz=1.0 / dt, sim_rate_hz=sim_rate_hz,
