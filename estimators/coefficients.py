@@ -10,7 +10,8 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from maneuvers.recording import G0_FPS2, Recording
+from maneuvers.recording import Recording
+from models.constants import G0_FPS2
 
 
 def accelerometer_at_cg(ax_g, ay_g, az_g, p, q, r, pdot, qdot, rdot, r_ft) -> tuple[np.ndarray, ...]:

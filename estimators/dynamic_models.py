@@ -34,13 +34,15 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from maneuvers.recording import G0_FPS2, Recording
+from maneuvers.recording import Recording, RecordingError
+from models.errors import UserError
+from models.constants import G0_FPS2
 
 __all__ = ["ManeuverData", "Model", "ModelDefinitionError", "ModelProtocol", "Parameter", "load_model_file",
            "maneuver_data", "recording_constants", "simulate"]
 
 
-class ModelDefinitionError(ValueError):
+class ModelDefinitionError(UserError):
     """A model specification or model file that cannot be used; the message names the rule."""
 
 
@@ -242,7 +244,7 @@ def maneuver_data(rec: Recording, model) -> ManeuverData:
     (total values in the recording's units), with :func:`recording_constants`."""
     missing = [c for c in tuple(model.inputs) + tuple(model.outputs) if not rec.has(c)]
     if missing:
-        raise ValueError(f"recording {rec.name!r} has no channel {', '.join(missing)} that model "
+        raise RecordingError(f"recording {rec.name!r} has no channel {', '.join(missing)} that model "
                          f"{model.name!r} needs (inputs {tuple(model.inputs)}, outputs {tuple(model.outputs)})")
     u = np.column_stack([rec.channel(c) for c in model.inputs]) if model.inputs else np.zeros((rec.n, 0))
     z = np.column_stack([rec.channel(c) for c in model.outputs])

@@ -18,6 +18,7 @@ from estimators.regressors import DataOptions, Equation, RegressionData, regress
 from estimators.result import ModelFit, collinearity
 from estimators.smoothing import optimal_fourier_smoother, sine_series_filter
 from maneuvers.recording import Recording
+from models.errors import OptionError
 
 ERRORS = ("conventional", "colored")
 DETRENDS = ("lstsq", "endpoints")
@@ -129,7 +130,7 @@ class EquationErrorTime:
         if self.errors is None:
             object.__setattr__(self, "errors", "colored" if self.smooth_regressors else "conventional")
         if self.errors not in ERRORS:
-            raise ValueError(f"errors must be one of {ERRORS}, not {self.errors!r}")
+            raise OptionError(f"errors must be one of {ERRORS}, not {self.errors!r}")
 
     @property
     def method(self) -> str:
@@ -178,7 +179,7 @@ def detrend(x: np.ndarray, how: str = "lstsq") -> np.ndarray:
         A = np.column_stack([np.ones(n), s.ravel()])
         coef, *_ = np.linalg.lstsq(A, x.reshape(n, -1), rcond=None)
         return x - (A @ coef).reshape(x.shape)
-    raise ValueError(f"detrend must be 'endpoints' or 'lstsq', not {how!r}")
+    raise OptionError(f"detrend must be 'endpoints' or 'lstsq', not {how!r}")
 
 
 def frequency_band(frequencies_hz, duration_s: float) -> np.ndarray:
@@ -193,7 +194,7 @@ def frequency_band(frequencies_hz, duration_s: float) -> np.ndarray:
     if isinstance(frequencies_hz, str):
         if frequencies_hz in ("eq18", "sidpac"):
             return seed_frequencies()
-        raise ValueError(f"frequency band {frequencies_hz!r}: use one of {BANDS} or give frequencies")
+        raise OptionError(f"frequency band {frequencies_hz!r}: use one of {BANDS} or give frequencies")
     return np.asarray(frequencies_hz, dtype=float)
 
 
@@ -220,9 +221,9 @@ class EquationErrorFrequency:
 
     def __post_init__(self) -> None:
         if self.detrend not in DETRENDS:
-            raise ValueError(f"detrend must be one of {DETRENDS}, not {self.detrend!r}")
+            raise OptionError(f"detrend must be one of {DETRENDS}, not {self.detrend!r}")
         if isinstance(self.frequencies_hz, str) and self.frequencies_hz not in BANDS:
-            raise ValueError(f"frequency band {self.frequencies_hz!r}: use one of {BANDS} or give frequencies")
+            raise OptionError(f"frequency band {self.frequencies_hz!r}: use one of {BANDS} or give frequencies")
 
     def transform(self, d: RegressionData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Frequencies (Hz) and the transforms of z and X."""

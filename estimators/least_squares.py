@@ -5,9 +5,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
+from models.errors import UserError
 
 
-class SingularRegressorsError(ValueError):
+class SingularRegressorsError(UserError):
     """The regressors are linearly dependent; the message names the columns involved."""
 
 

@@ -6,6 +6,7 @@ from typing import Protocol
 from estimators.equation_error import SIDPAC_FREQUENCY_OPTIONS, EquationErrorFrequency, EquationErrorTime
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit
+from models.errors import OptionError
 
 METHODS = ("ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe")
 __all__ = ["METHODS", "SIDPAC_FREQUENCY_OPTIONS", "Estimator", "make_estimator", "parse_frequencies"]
@@ -39,7 +40,7 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
     if name == "ee-smooth":
         return EquationErrorTime(errors=errors, max_lag=max_lag, smooth_regressors=True, data=data)
     if name in ("ee-freq", "oe", "oe-freq", "fe") and errors == "colored":
-        raise ValueError(f"--errors colored applies to the time-domain equation-error methods, not {name}: "
+        raise OptionError(f"--errors colored applies to the time-domain equation-error methods, not {name}: "
                          "the frequency-domain residuals are treated as white over the band (seed §III.E) "
                          "and output error reports the Cramér-Rao bound")
     if name == "ee-freq":
@@ -53,7 +54,7 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
     if name == "fe":
         from estimators.filter_error import FilterError
         return FilterError(data=data)
-    raise ValueError(f"unknown method {name!r}; choose one of {METHODS}")
+    raise OptionError(f"unknown method {name!r}; choose one of {METHODS}")
 
 
 def parse_frequencies(text: str) -> tuple[float, ...] | str:
@@ -66,13 +67,13 @@ def parse_frequencies(text: str) -> tuple[float, ...] | str:
         try:
             f0, df, f1 = (float(x) for x in text.split(":"))
         except ValueError:
-            raise ValueError(f"--frequencies must be auto, eq18, sidpac, F0:DF:F1 or a comma list, "
+            raise OptionError(f"--frequencies must be auto, eq18, sidpac, F0:DF:F1 or a comma list, "
                              f"not {text!r}") from None
         if not (0 < f0 < f1 and df > 0):
-            raise ValueError(f"--frequencies {text!r}: need 0 < F0 < F1 and DF > 0")
+            raise OptionError(f"--frequencies {text!r}: need 0 < F0 < F1 and DF > 0")
         n = int(round((f1 - f0) / df)) + 1
         return tuple(float(x) for x in f0 + df * np.arange(n))
     vals = tuple(float(x) for x in text.split(",") if x.strip())
     if not vals or min(vals) <= 0:
-        raise ValueError(f"--frequencies {text!r}: give positive frequencies")
+        raise OptionError(f"--frequencies {text!r}: give positive frequencies")
     return vals

@@ -38,6 +38,7 @@ from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit, collinearity
 from estimators.state_space import HOLDS, short_period_dimensional
 from maneuvers.recording import Recording
+from models.errors import OptionError, UserError
 
 __all__ = ["DivergenceError", "NotIdentifiableError", "OutputError", "OutputErrorData",
            "OutputErrorFailure", "cramer_rao_bound", "flight_constants", "output_error_data",
@@ -53,7 +54,7 @@ IDENTIFIABILITY_LIMIT = 1e-10  # smallest/largest eigenvalue of the scaled infor
 NOISE_FLOOR = 1e-12  # R_jj never below this fraction of the output's variance
 
 
-class OutputErrorFailure(ValueError):
+class OutputErrorFailure(UserError):
     """Output error could not produce estimates; the message names the cause."""
 
 
@@ -291,7 +292,7 @@ class OutputError:
         from estimators.output_error_general import fit_model
         model = self.model
         if equation is not None and equation.regressors:
-            raise ValueError(f"output error fits model {model.name!r} as it is written; it takes no equation "
+            raise OptionError(f"output error fits model {model.name!r} as it is written; it takes no equation "
                              f"(got {equation.describe()}): leave out the regressors")
         sources = list(source) if isinstance(source, (list, tuple)) else [source]
         datasets = [s if isinstance(s, ManeuverData) else maneuver_data(s, model) if isinstance(s, Recording)
@@ -330,7 +331,7 @@ class OutputError:
         if self.model is not None and not isinstance(self.model, str):
             return self._fit_model(source, equation)
         if isinstance(source, (list, tuple)):
-            raise ValueError("several maneuvers are fitted with a Model (estimators.dynamic_models); the built-in "
+            raise OptionError("several maneuvers are fitted with a Model (estimators.dynamic_models); the built-in "
                              "models take one recording")
         data = resolve_data(source, self.model, equation, self.data)
         name = data.model
@@ -348,7 +349,7 @@ class OutputError:
         spec, given = problem.data.spec, dict(self.start or {})
         unknown = sorted(set(given) - set(spec.names))
         if unknown:
-            raise ValueError(f"start has unknown parameters {unknown}; {spec.name} has {spec.names}")
+            raise OptionError(f"start has unknown parameters {unknown}; {spec.name} has {spec.names}")
         origin = "given"
         if any(d not in given for d in spec.derivatives):
             if isinstance(source, Recording):

@@ -31,7 +31,11 @@ from estimators.regressors import DataOptions, Equation, regression_data
 from estimators.state_space import (LATERAL_DERIVATIVES, discretize, discretize_derivatives,
                                     lateral_matrices, propagate, scan, short_period_dimensional,
                                     short_period_matrices)
-from maneuvers.recording import G0_FPS2, Recording
+from maneuvers.recording import Recording
+from models.errors import OptionError
+from maneuvers.recording import RecordingError
+from estimators.regressors import EquationError
+from models.constants import G0_FPS2
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -179,7 +183,7 @@ def flight_from_constants(constants: Mapping[str, float]) -> FlightConstants:
         return FlightConstants(**values)
     except TypeError:
         missing = [k for k in FlightConstants.__dataclass_fields__ if k not in values]
-        raise ValueError(f"the built-in linear models need the constants {missing}") from None
+        raise RecordingError(f"the built-in linear models need the constants {missing}") from None
 
 
 def check_equation(spec: ModelSpec, equation: Equation | None) -> None:
@@ -189,11 +193,11 @@ def check_equation(spec: ModelSpec, equation: Equation | None) -> None:
         return
     terms = {eq.dependent: eq.regressors for eq in spec.equations}
     if equation.dependent not in terms:
-        raise ValueError(f"output error's {spec.name} model has no {equation.dependent} equation (it fits "
+        raise EquationError(f"output error's {spec.name} model has no {equation.dependent} equation (it fits "
                          f"{', '.join(terms)}): give a model of your own (--model-file) or use equation error")
     extra = [r for r in equation.regressors if r not in terms[equation.dependent]]
     if extra:
-        raise ValueError(f"output error's {spec.name} model has no {', '.join(extra)} term in {equation.dependent} "
+        raise EquationError(f"output error's {spec.name} model has no {', '.join(extra)} term in {equation.dependent} "
                          f"(it has {', '.join(terms[equation.dependent])}): give a model that has it "
                          "(--model-file) or use equation error")
 
@@ -207,10 +211,10 @@ def model_spec(model: str | None, equation: Equation | None = None) -> ModelSpec
         elif equation.dependent in LATERAL_COEFFICIENTS:
             model = "lateral"
         else:
-            raise ValueError(f"cannot choose an output-error model for dependent {equation.dependent!r}: "
+            raise EquationError(f"cannot choose an output-error model for dependent {equation.dependent!r}: "
                              f"use one of {LONGITUDINAL_COEFFICIENTS + LATERAL_COEFFICIENTS} or give model=")
     if model not in MODELS:
-        raise ValueError(f"unknown output-error model {model!r}; use one of {list(MODELS)}")
+        raise OptionError(f"unknown output-error model {model!r}; use one of {list(MODELS)}")
     return MODELS[model]
 
 

@@ -22,15 +22,16 @@ import numpy as np
 from estimators.coefficients import coefficient_from_recording, thrust_assumption, thrust_source
 from estimators.differentiation import smooth_derivative
 from maneuvers.recording import Recording, RecordingError
+from models.errors import UserError
+from models.constants import COEFFICIENTS
 
-COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn", "CL", "CD")
 ACCELERATION_METHODS = ("auto", "recorded", "smooth-local", "smooth-fourier", "local-smooth")
 REFERENCES = ("trim", "first", "none")
 _SEED_METHOD = {"smooth-local": 1, "smooth-fourier": 2, "local-smooth": 3}
 _TERM = re.compile(r"^([A-Za-z][A-Za-z0-9_]*?)(?:\^([0-9]+))?$")
 
 
-class EquationError(ValueError):
+class EquationError(UserError):
     """A model equation that cannot be built from the recording (unknown term, missing channel)."""
 
 

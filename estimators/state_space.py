@@ -17,7 +17,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from maneuvers.recording import G0_FPS2
+from models.constants import G0_FPS2
 
 HOLDS = ("zoh", "foh")
 LATERAL_DERIVATIVES: tuple[str, ...] = tuple(

@@ -9,9 +9,10 @@
 * Anything else is an **internal error** (a bug): its traceback is printed, followed by one
   line saying so, and the command exits with status 1.
 
-New user-facing errors derive from :class:`UserError`. Estimators, models and the diagnosis
-still raise plain ``ValueError`` for some user-facing problems; those keep the one-line form
-(a compatible mapping), with a pointer to ``--debug``.
+User-facing errors derive from :class:`UserError` (defined in :mod:`models.errors`, the lowest
+package, so that every package can raise it); a trim or flight failure (``TrimError``,
+``FlightError``), a failed diagnosis and a path the user gave that cannot be used are user errors
+too. A plain ``ValueError`` is not: it is a bug, reported with its traceback.
 """
 from __future__ import annotations
 
@@ -20,13 +21,10 @@ import traceback
 from collections.abc import Callable
 from typing import Any, TextIO
 
+from models.errors import OptionError, UserError
 
-class UserError(ValueError):
-    """Something the user can fix; the message names the file, key or option and the rule."""
-
-
-class OptionError(UserError):
-    """A command-line option with a value the command cannot use."""
+__all__ = ["UserError", "OptionError", "OutputPathError", "Interrupted", "user_errors", "quiet_broken_pipe",
+           "run_reporting_errors", "EXIT_USER", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
 
 
 class OutputPathError(UserError):
@@ -47,24 +45,14 @@ _PATH_ERRORS: tuple[type[BaseException], ...] = (
 
 
 def user_errors() -> tuple[type[BaseException], ...]:
-    """Every exception type reported as a user error (imported lazily: this module is imported
-    by the modules that define some of them)."""
-    from estimators.least_squares import SingularRegressorsError
-    from estimators.regressors import EquationError
+    """Every exception type reported as a user error: :class:`UserError` and its subclasses (a
+    malformed recording, input spec, equation, campaign, column map, output-error model...), a
+    failed trim or flight, a failed diagnosis, running out of memory and an unusable path.
+    Imported lazily: some of these modules import this one."""
     from harness.diagnosis.run import DiagnosisError
-    from maneuvers.base import InputSpecError
-    from maneuvers.recording import RecordingError
     from models.flight import FlightError
     from models.trim import TrimError
-    return (UserError, RecordingError, TrimError, FlightError, InputSpecError, SingularRegressorsError,
-            EquationError, DiagnosisError, MemoryError) + _PATH_ERRORS
-
-
-def __getattr__(name: str) -> Any:
-    # ``USER_ERRORS`` (the former constant) stays importable, built on first use.
-    if name == "USER_ERRORS":
-        return user_errors() + (ValueError,)
-    raise AttributeError(name)
+    return (UserError, TrimError, FlightError, DiagnosisError, MemoryError) + _PATH_ERRORS
 
 
 def _one_line(exc: BaseException) -> str:
@@ -109,13 +97,6 @@ def run_reporting_errors(func: Callable[[Any], int | None], args: Any, command: 
         if debug:
             traceback.print_exc(file=err)
         print(f"{prefix}: error: {_one_line(exc)}", file=err)
-        return EXIT_USER
-    except ValueError as exc:
-        # Compatible mapping: estimators and models raise plain ValueError for user-facing problems.
-        if debug:
-            traceback.print_exc(file=err)
-        print(f"{prefix}: error: {_one_line(exc)}" + ("" if debug else " (--debug shows the traceback)"),
-              file=err)
         return EXIT_USER
     except Exception as exc:  # noqa: BLE001 - a bug: keep its traceback
         traceback.print_exc(file=err)

@@ -76,11 +76,11 @@ def parse_loop(text: str):
         return Loop()
     kind, _, gain = text.partition(":")
     if kind != "closed" or not gain:
-        raise ValueError(f"--loop must be 'open' or 'closed:K' (e.g. closed:0.5), not {text!r}")
+        raise OptionError(f"--loop must be 'open' or 'closed:K' (e.g. closed:0.5), not {text!r}")
     try:
         return Loop("closed", float(gain))
     except ValueError:
-        raise ValueError(f"--loop closed:K needs a number for K, not {gain!r}") from None
+        raise OptionError(f"--loop closed:K needs a number for K, not {gain!r}") from None
 
 
 def spec_from_args(args: argparse.Namespace):

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from scipy.stats import norm
+from models.errors import UserError
 
 DEFAULT_GATES = Path(__file__).resolve().parent / "nightly-gates.toml"
 
@@ -45,11 +46,11 @@ def load_gates(path: str | Path = DEFAULT_GATES) -> tuple[Gate, ...]:
     try:
         d = tomllib.loads(p.read_text())
     except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise ValueError(f"cannot read gates file {p}: {exc}") from None
+        raise UserError(f"cannot read gates file {p}: {exc}") from None
     gates = []
     for i, g in enumerate(d.get("gate", [])):
         if g.get("kind") not in ("coverage", "bias", "movement"):
-            raise ValueError(f"{p}: gate {i} ({g.get('name')!r}): kind must be coverage, bias or movement")
+            raise UserError(f"{p}: gate {i} ({g.get('name')!r}): kind must be coverage, bias or movement")
         gates.append(Gate(name=g.get("name", g["kind"]), kind=g["kind"], methods=tuple(g.get("methods", ())),
                           noise=tuple(g.get("noise", ())), dependents=tuple(g.get("dependents", ())),
                           low=float(g.get("low", 0.0)), high=float(g.get("high", 1.0)), z=g.get("z", "family"),

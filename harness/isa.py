@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
+from models.errors import UserError
 
 T0_K = 288.15
 P0_PA = 101325.0
@@ -34,7 +35,7 @@ def pressure_pa(h_ft: npt.ArrayLike) -> np.ndarray:
     """
     h_m = np.asarray(h_ft, dtype=np.float64) * FT_M
     if np.any(h_m > TOP_M):
-        raise ValueError(f"altitude above {TOP_M / FT_M:.0f} ft is outside the ISA layers modelled")
+        raise UserError(f"altitude above {TOP_M / FT_M:.0f} ft is outside the ISA layers modelled")
     p11 = P0_PA * (_T11 / T0_K) ** _EXPONENT
     tropo = P0_PA * (1.0 - LAPSE_K_PER_M * np.minimum(h_m, TROPOPAUSE_M) / T0_K) ** _EXPONENT
     strato = p11 * np.exp(-G0_MPS2 * (h_m - TROPOPAUSE_M) / (R_J_PER_KG_K * _T11))
@@ -47,7 +48,7 @@ def density_altitude_ft(rho_slugft3: npt.ArrayLike) -> np.ndarray:
     above it. On a standard day it equals the pressure altitude."""
     rho = np.asarray(rho_slugft3, dtype=np.float64) / SLUGFT3_PER_KGM3
     if np.any(~(rho > 0)):
-        raise ValueError("density must be positive to give an altitude")
+        raise UserError("density must be positive to give an altitude")
     tropo_m = (T0_K - T0_K * (rho / _RHO0) ** (1.0 / (_EXPONENT - 1.0))) / LAPSE_K_PER_M
     strato_m = TROPOPAUSE_M - np.log(rho / _RHO11) * R_J_PER_KG_K * _T11 / G0_MPS2
     return np.where(rho >= _RHO11, tropo_m, strato_m) / FT_M

@@ -31,7 +31,8 @@ import pandas as pd
 from estimators.state_space import (discretize, expm_small, lateral_matrices, propagate, short_period_dimensional,
                                     short_period_matrices, simulate_linear)
 from harness.campaign import FlightKey
-from maneuvers.recording import G0_FPS2, Recording
+from maneuvers.recording import Recording
+from models.constants import G0_FPS2, SURFACES
 
 LATERAL = ("CY", "Cl", "Cn")
 LAT_VARS = ("beta", "phat", "rhat", "da", "dr")
@@ -111,7 +112,7 @@ def linear_flight(key: FlightKey, fly_nominal, turbulence=None, turbulence_seed:
     K = float(key.loop.split(":")[1]) if key.loop.startswith("closed") else 0.0
     signal = key.maneuver.build().deflections(t)
     zero = np.zeros(n)
-    de_cmd, da, dr = (np.asarray(signal.get(s, zero), float) for s in ("de", "da", "dr"))
+    de_cmd, da, dr = (np.asarray(signal.get(s, zero), float) for s in SURFACES)
 
     dim = short_period_dimensional(truth["CZ_alpha"], truth["CZ_qhat"], truth["CZ_de"], truth["Cm_alpha"],
                                    truth["Cm_qhat"], truth["Cm_de"], qbar, S, c, m["mass_slug"], m["Iy_slugft2"], V)

@@ -20,6 +20,7 @@ import pandas as pd
 
 from maneuvers.recording import Recording
 from models.atmosphere import Turbulence
+from models.errors import OptionError
 
 
 @dataclass(frozen=True)
@@ -56,11 +57,11 @@ class ChannelNoise:
     def __post_init__(self) -> None:
         for name in ("white_std", "colored_std", "quantum", "spike_rate_hz", "spike_std"):
             if not (getattr(self, name) >= 0.0):
-                raise ValueError(f"noise {name} must be non-negative, not {getattr(self, name)!r}")
+                raise OptionError(f"noise {name} must be non-negative, not {getattr(self, name)!r}")
         if self.colored_tau_s <= 0:
-            raise ValueError("colored_tau_s must be positive")
+            raise OptionError("colored_tau_s must be positive")
         if self.band_hz is not None and not (0 <= self.band_hz[0] < self.band_hz[1]):
-            raise ValueError(f"band_hz must be (f_lo, f_hi) with 0 <= f_lo < f_hi, not {self.band_hz}")
+            raise OptionError(f"band_hz must be (f_lo, f_hi) with 0 <= f_lo < f_hi, not {self.band_hz}")
 
     @property
     def is_zero(self) -> bool:

@@ -24,9 +24,10 @@ import math
 
 from harness.noise import ChannelNoise, NoiseModel
 from models.atmosphere import Turbulence
+from models.errors import OptionError
+from models.constants import G0_FPS2 as G0
 
 DEG = math.pi / 180.0
-G0 = 32.17404855643
 ANGULAR_ACCELERATIONS = ("pdot", "qdot", "rdot")
 
 _SOURCE = ("ISRN Aerospace Engineering 2014, article 409408, Table 3 (alpha, beta, rates, "
@@ -76,7 +77,7 @@ def preset(name: str) -> NoiseModel:
     if name == "turbulence-moderate":
         return NoiseModel.build("turbulence-moderate", _white(), turbulence=Turbulence("dryden", 3, 30.0),
                                 source=_SOURCE + "; JSBSim MIL-spec Dryden, severity 3", drop=ANGULAR_ACCELERATIONS)
-    raise ValueError(f"unknown noise preset {name!r}; choose one of {PRESETS}")
+    raise OptionError(f"unknown noise preset {name!r}; choose one of {PRESETS}")
 
 
 PRESETS = ("none", "white", "realistic", "heavy", "turbulence-light", "turbulence-moderate")

@@ -15,6 +15,7 @@ from harness.campaign import FlightKey, Task
 from harness.noise import apply_noise, output_noise, stream
 from harness.recording_io import read_recording, write_recording
 from maneuvers.recording import Recording
+from models.constants import SURFACES
 
 LONGITUDINAL = ("CX", "CZ", "Cm", "CL", "CD")
 TIME_DOMAIN = ("ee-time", "ee-smooth")
@@ -45,9 +46,6 @@ def cached_flight(key: FlightKey, cache_dir: str | Path) -> Recording:
     rec = fly_key(key)
     write_recording(rec, path)
     return rec
-
-
-SURFACES = ("de", "da", "dr")
 
 
 def excited_equations(rec: Recording, equations: tuple[Equation, ...]) -> tuple[Equation, ...]:

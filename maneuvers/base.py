@@ -23,9 +23,10 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
+from models.errors import UserError
+from models.constants import SURFACES
 
-SURFACES: tuple[str, ...] = ("de", "da", "dr")
-"""Valid surface names, in pitch, roll, yaw order."""
+# SURFACES (models.constants): valid surface names, in pitch, roll, yaw order.
 
 SURFACE_WORDS: MappingProxyType[str, str] = MappingProxyType(
     {"de": "stabilator", "da": "aileron", "dr": "rudder"}
@@ -33,7 +34,7 @@ SURFACE_WORDS: MappingProxyType[str, str] = MappingProxyType(
 """Human-readable word for each surface, used by ``describe()`` and names."""
 
 
-class InputSpecError(ValueError):
+class InputSpecError(UserError):
     """An input specification is invalid (bad surface, negative duration, ...)."""
 
 

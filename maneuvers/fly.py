@@ -18,6 +18,8 @@ from models.atmosphere import Turbulence
 from models.flight import FlightHistory, Loop, fly
 from models.trim import TrimPoint, trim
 from models.truth import Derivatives, excursion_from_history, truth_derivatives
+from models.errors import UserError
+from maneuvers.base import InputSpecError
 
 DEFAULT_DURATION_S = 20.0  # the seed's records are 20 s at 50 Hz
 
@@ -61,7 +63,7 @@ class FlightSpec:
     def length_s(self) -> float:
         if self.duration_s is not None:
             if self.duration_s < self.input.duration_s - 1e-9:
-                raise ValueError(f"duration {self.duration_s} s is shorter than the input "
+                raise InputSpecError(f"duration {self.duration_s} s is shorter than the input "
                                  f"{self.input.describe()} ({self.input.duration_s} s)")
             return self.duration_s
         return max(DEFAULT_DURATION_S, math.ceil(self.input.duration_s))
@@ -79,7 +81,7 @@ def _load_and_trim(spec: FlightSpec) -> tuple[jsbsim.FGFDMExec, TrimPoint, dict]
         kwargs = {"root": root, "name": name}
     elif spec.aircraft.hidden and needs_copy(spec.aircraft.hidden):
         if spec.aircraft.variant != "nominal":
-            raise ValueError("hidden effects are added to the nominal aircraft only")
+            raise UserError("hidden effects are added to the nominal aircraft only")
         root, name = hidden_root(spec.aircraft, cond)
         kwargs = {"root": root, "name": name}
     fdm = load_fdm(spec.aircraft, 1.0 / 120.0, **kwargs)

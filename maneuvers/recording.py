@@ -44,6 +44,8 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from models.errors import UserError
+from models.constants import G0_FPS2, G0_MPS2, SURFACES
 
 __all__ = [
     "CHANNELS",
@@ -75,13 +77,9 @@ __all__ = [
 FORMAT_ID = "flight-recording/1"
 """Value required in ``meta['format']``."""
 
-G0_FPS2 = 32.17404855643
-"""Standard gravity, 9.80665 m/s^2 expressed in ft/s^2; used for g <-> fps2."""
-
 TIME_JITTER_TOL = 1e-6
 """Largest accepted relative deviation of a time step from the mean step."""
 
-_G0_MPS2 = 9.80665  # standard gravity, m/s^2 (exact by definition)
 _FT_M = 0.3048  # international foot, m (exact)
 _LBF_N = 4.4482216152605  # pound-force, N (exact)
 _KT_FPS = 1852.0 / 3600.0 / _FT_M  # knot, ft/s (= 1.6878098571...)
@@ -96,7 +94,7 @@ MASS_KEYS: tuple[str, ...] = ("mass_slug", "Ix_slugft2", "Iy_slugft2", "Iz_slugf
 
 _POSITIVE_MASS_KEYS = frozenset(MASS_KEYS[:4])  # Ixz may have either sign
 
-CONTROL_QUANTITIES: tuple[str, ...] = ("de", "da", "dr")
+CONTROL_QUANTITIES: tuple[str, ...] = SURFACES
 """Control-surface quantities; at least one must be present."""
 
 _TRUTH_PREFIX = "truth_"
@@ -109,7 +107,7 @@ _UNIT_RE = re.compile(r"[A-Za-z0-9]+")
 # --------------------------------------------------------------------------------------
 
 
-class RecordingError(ValueError):
+class RecordingError(UserError):
     """A recording breaks a rule of the format.
 
     The message names the file (or the recording, when no file is known), the column
@@ -230,7 +228,7 @@ def _build_channels() -> Mapping[str, ChannelSpec]:
     angle = {"rad": 1.0, "deg": _DEG_RAD}
     rate = {"rps": 1.0, "dps": _DEG_RAD}
     accel = {"rps2": 1.0, "dps2": _DEG_RAD}
-    specific_force = {"g": 1.0, "fps2": 1.0 / G0_FPS2, "mps2": 1.0 / _G0_MPS2}
+    specific_force = {"g": 1.0, "fps2": 1.0 / G0_FPS2, "mps2": 1.0 / G0_MPS2}
     rows: list[tuple[str, str, dict[str, float], bool, str]] = [
         ("t", "s", {"s": 1.0}, True, "time, strictly increasing, uniform step"),
         ("V", "fps", {"fps": 1.0, "kts": _KT_FPS, "mps": 1.0 / _FT_M}, True, "true airspeed"),

@@ -1,7 +1,10 @@
 """Aircraft: JSBSim loading, trim, surface drive, truth derivatives and variants.
 
-The public names are re-exported here; each lives in a short module of its own:
+Each part lives in a short module of its own (import from it directly; importing the package
+itself loads nothing, so that the packages to its right can take its constants without JSBSim):
 
+- :mod:`models.constants`   standard gravity, the surface and coefficient names
+- :mod:`models.errors`      the user-error types every package raises for input the user can fix
 - :mod:`models.conditions`  named flight conditions (altitude, airspeed)
 - :mod:`models.aircraft`    which aircraft and variant to fly, and loading it into JSBSim
 - :mod:`models.jsbsim_root` aircraft copies written to a JSBSim root of their own
@@ -11,14 +14,3 @@ The public names are re-exported here; each lives in a short module of its own:
 - :mod:`models.linearization` the cross-check through ``jsbsim.FGLinearization``
 - :mod:`models.exact`       the exact-truth variant (aerodynamics exactly linear)
 """
-from models.aircraft import Aircraft, VARIANTS, load_fdm
-from models.conditions import FlightCondition, condition_for, conditions_for
-from models.trim import TrimError, TrimPoint, trim
-from models.flight import FlightError, Loop, fly
-from models.truth import DERIVATIVE_NAMES, Derivatives, truth_derivatives
-
-__all__ = [
-    "Aircraft", "VARIANTS", "load_fdm", "FlightCondition", "condition_for", "conditions_for",
-    "TrimError", "TrimPoint", "trim", "FlightError", "Loop", "fly",
-    "DERIVATIVE_NAMES", "Derivatives", "truth_derivatives",
-]

@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import jsbsim
+from models.errors import OptionError
 
 # JSBSim's turb-type codes: the header comments say 4/5, the code uses 3/4 (../shared/jsbsim-notes.md).
 TURB_TYPE = {"dryden": 3, "tustin": 4}
@@ -25,11 +26,11 @@ class Turbulence:
 
     def __post_init__(self) -> None:
         if self.kind not in TURB_TYPE:
-            raise ValueError(f"turbulence kind must be one of {sorted(TURB_TYPE)}, not {self.kind!r}")
+            raise OptionError(f"turbulence kind must be one of {sorted(TURB_TYPE)}, not {self.kind!r}")
         if not 0 <= self.severity <= 7:
-            raise ValueError("turbulence severity must be 0..7 (JSBSim's MIL-spec index)")
+            raise OptionError("turbulence severity must be 0..7 (JSBSim's MIL-spec index)")
         if self.wind_20ft_fps < 0:
-            raise ValueError("wind at 20 ft must be non-negative")
+            raise OptionError("wind at 20 ft must be non-negative")
 
     def describe(self) -> str:
         return f"{self.kind} turbulence, severity {self.severity}, wind at 20 ft {self.wind_20ft_fps:g} ft/s"

@@ -2,6 +2,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from models.errors import UserError
+
+
+class ConditionError(UserError):
+    """An unknown or malformed flight condition, or an aircraft without any."""
 
 
 @dataclass(frozen=True)
@@ -61,7 +66,7 @@ def conditions_for(model: str) -> tuple[FlightCondition, ...]:
     try:
         return _CONDITIONS[model]
     except KeyError:
-        raise ValueError(f"no flight conditions are defined for aircraft {model!r}; "
+        raise ConditionError(f"no flight conditions are defined for aircraft {model!r}; "
                          f"known aircraft: {sorted(_CONDITIONS)}") from None
 
 
@@ -84,17 +89,17 @@ def parse_condition(text: str) -> FlightCondition:
         key, sep, value = part.partition("=")
         key = key.strip()
         if not sep or key not in _CONDITION_KEYS:
-            raise ValueError(f"condition {text!r}: expected h=<ft>,V=<ft/s>, e.g. h=10000,V=427.4 "
+            raise ConditionError(f"condition {text!r}: expected h=<ft>,V=<ft/s>, e.g. h=10000,V=427.4 "
                              f"(unknown or malformed part {part.strip()!r})")
         try:
             values[key] = float(value)
         except ValueError:
-            raise ValueError(f"condition {text!r}: {key} must be a number, not {value.strip()!r}") from None
+            raise ConditionError(f"condition {text!r}: {key} must be a number, not {value.strip()!r}") from None
     for key, (unit, lo, hi) in _CONDITION_KEYS.items():
         if key not in values:
-            raise ValueError(f"condition {text!r}: {key} is missing (expected h=<ft>,V=<ft/s>)")
+            raise ConditionError(f"condition {text!r}: {key} is missing (expected h=<ft>,V=<ft/s>)")
         if not lo <= values[key] <= hi:
-            raise ValueError(f"condition {text!r}: {key} = {values[key]:g} {unit} is outside {lo:g} to {hi:g}")
+            raise ConditionError(f"condition {text!r}: {key} = {values[key]:g} {unit} is outside {lo:g} to {hi:g}")
     h, V = values["h"], values["V"]
     return FlightCondition(f"h={h:g},V={V:g}", h, V, "given by value (h in ft, V in ft/s true airspeed)")
 
@@ -115,5 +120,5 @@ def condition_for(model: str, name: str | None = None) -> FlightCondition:
     for c in conds:
         if c.name == name:
             return c
-    raise ValueError(f"aircraft {model!r} has no flight condition {name!r}; "
+    raise ConditionError(f"aircraft {model!r} has no flight condition {name!r}; "
                      f"choose one of {[c.name for c in conds]}")

@@ -11,7 +11,8 @@ import numpy as np
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence, start_turbulence
 from models.hidden import apply_sensor_effects, delay_deltas, delay_property, frames_of
-from models.trim import G0_FPS2, TrimPoint
+from models.trim import TrimPoint
+from models.constants import G0_FPS2
 
 Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
 

@@ -33,15 +33,14 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
+from models.constants import BODY_COEFFICIENTS as COEFFICIENTS, G0_FPS2, SURFACES
 
 AERO_TERMS = ("unsteady_alphadot", "nonlinear_alpha", "coefficient_error", "cross_coupling",
               "flight_condition_drift", "cg_offset")
 SENSOR_EFFECTS = ("sensor_offset", "sensor_bias", "sensor_scale", "sensor_time_skew")
 EFFECTS = AERO_TERMS + ("control_delay",) + SENSOR_EFFECTS
-COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 REGRESSORS = ("alpha", "beta", "phat", "qhat", "rhat", "de", "da", "dr")
 SENSOR_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "phi", "theta", "ax", "ay", "az")
-G0_FPS2 = 32.17404855643
 
 # JSBSim axis, sign and reference length of each coefficient's added function. Force terms go
 # to the wind-axis DRAG and LIFT (CX ≈ −CD, CZ ≈ −CL at small α): an approximation.
@@ -84,7 +83,7 @@ class HiddenEffect:
             raise ValueError(f"the size of {self.effect} must be finite")
         if self.effect == "control_delay" and not self.size >= 0:
             raise ValueError("a control delay must be non-negative seconds")
-        if self.surface not in ("de", "da", "dr"):
+        if self.surface not in SURFACES:
             raise ValueError("surface must be de, da or dr")
         if self.coefficient not in COEFFICIENTS:
             raise ValueError(f"coefficient must be one of {COEFFICIENTS}")
@@ -174,7 +173,7 @@ def _factor(parent: ET.Element, name: str, ref: float, surfaces: dict[str, str])
     elif name == "alphadot":
         _prop(parent, "aero/ci2vel")
         _prop(parent, "aero/alphadot-rad_sec")
-    elif name in ("de", "da", "dr"):
+    elif name in SURFACES:
         _difference(parent, surfaces[name], ref)
     elif name == "dV":
         _difference(parent, "velocities/vt-fps", ref)

@@ -19,8 +19,8 @@ from models.flight import FlightHistory, fly
 from models.hidden import hidden_root, needs_copy
 from models.trim import TrimError, TrimPoint, trim
 from models.truth import CoefficientProbe, central_differences, differencing_instance
+from models.constants import BODY_COEFFICIENTS, SURFACES
 
-SURFACES = ("de", "da", "dr")
 
 
 @dataclass(frozen=True)
@@ -138,7 +138,7 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     setters = {p: pm.get_node(p).set_double_value for p in
                ("ic/h-sl-ft", "ic/vt-fps", "ic/alpha-rad", "ic/beta-rad", "ic/theta-rad", "ic/phi-rad",
                 "ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", surf["de"], surf["da"], surf["dr"])}
-    out = {c: np.empty(n) for c in ("CX", "CY", "CZ", "Cl", "Cm", "Cn")}
+    out = {c: np.empty(n) for c in BODY_COEFFICIENTS}
     fdm["ic/lat-gc-deg"] = 0.0
     fdm["ic/long-gc-deg"] = 0.0
     for k in range(n):

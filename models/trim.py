@@ -15,8 +15,8 @@ from models.aircraft import TRIM_MOMENT_PROPERTIES, Aircraft, is_turboprop, mode
 from models.conditions import FlightCondition
 from models.configuration import (SCHEDULED_SURFACES, command_configuration, configuration_record,
                                   cruise_configuration, place_configuration)
+from models.constants import G0_FPS2
 
-G0_FPS2 = 32.17404855643  # standard gravity, ft/s^2 (9.80665 m/s^2)
 
 
 class TrimError(RuntimeError):

@@ -29,6 +29,7 @@ from models.aircraft import Aircraft, load_fdm, model_xml, nominal_tree
 from models.conditions import FlightCondition
 from models.jsbsim_root import cached_root
 from models.trim import TrimPoint, place_untrimmed, trim
+from models.constants import COEFFICIENTS
 
 LONGITUDINAL_COEFFICIENTS = ("CL", "CD", "CX", "CZ", "Cm")
 LONGITUDINAL_VARIABLES = ("alpha", "qhat", "de")
@@ -37,7 +38,6 @@ LATERAL_VARIABLES = ("beta", "phat", "rhat", "da", "dr")
 DERIVATIVE_NAMES = tuple(
     [f"{c}_{v}" for c in LONGITUDINAL_COEFFICIENTS for v in LONGITUDINAL_VARIABLES]
     + [f"{c}_{v}" for c in LATERAL_COEFFICIENTS for v in LATERAL_VARIABLES])
-COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn", "CL", "CD")
 
 # Central-difference steps (rad, or non-dimensional rate). 1e-3 rad = 0.057 deg keeps the
 # stencil inside one table segment whenever trim lies more than that from a breakpoint.

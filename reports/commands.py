@@ -8,6 +8,7 @@ from pathlib import Path
 from reports.html import write_html
 from reports.jsonreport import write_json
 from reports.markdown import markdown_text, write_markdown
+from harness.errors import OptionError
 
 
 def write_all(report, out_dir: Path, stem: str = "report") -> Path:
@@ -27,7 +28,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         report = benchmark_report(outputs)
     else:
         if len(outputs) != 1:
-            raise ValueError("a campaign report takes one folder; use --kind benchmark to compare several")
+            raise OptionError("a campaign report takes one folder; use --kind benchmark to compare several")
         from reports.campaign_report import campaign_report
         report = campaign_report(outputs[0])
     out = Path(args.out) if args.out else Path(args.dirs[0])

@@ -28,6 +28,7 @@ from scipy.signal import welch
 
 from reports.figures_common import (FONT, PALETTE, SMALL, FigureOut, done, fmt, grid, new_figure,
                                     style_axes)
+from models.constants import BODY_COEFFICIENTS as COEFFICIENTS
 
 __all__ = ["CHANNELS", "COEFFICIENTS", "channel_label", "channel_values", "rms",
            "fig_worst_channels", "fig_coefficient_mismatch", "fig_mismatch_spectrum",
@@ -35,7 +36,6 @@ __all__ = ["CHANNELS", "COEFFICIENTS", "channel_label", "channel_values", "rms",
 
 CHANNELS: tuple[str, ...] = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
 """Output channels of the diagnosis series, in the contract's order."""
-COEFFICIENTS: tuple[str, ...] = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 """Non-dimensional force and moment coefficients, in the contract's order."""
 MAX_CHANNELS = 4
 _DEG = 180.0 / np.pi

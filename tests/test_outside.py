@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from models.constants import G0_FPS2 as G0
 
-G0 = 32.17404855643
 
 
 def independent_f16_recording(path: Path, duration_s: float = 20.0) -> dict:

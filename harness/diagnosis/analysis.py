@@ -13,6 +13,7 @@ from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficie
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
 from models.aircraft import Aircraft
 from models.replay import AeroAlong, InitialCondition, aero_along
+from models.constants import G0_FPS2
 
 SENSOR_UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s",
                 "phi": "rad", "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
@@ -77,7 +78,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # 0. turbulence first: gusts make air-relative and inertial velocities differ, which
     # breaks the kinematic consistency the sensor tests rest on
     gust = gust_estimate(kinematic_residuals(p.raw, p), p,
-                         0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * 32.174)
+                         0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * G0_FPS2)
     turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)

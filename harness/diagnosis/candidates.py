@@ -15,6 +15,7 @@ import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
 from harness.diagnosis.prepare import Prepared
+from models.constants import G0_FPS2 as G0
 
 T_IN = 5.0
 MIN_GAIN = 0.05
@@ -23,7 +24,6 @@ LAT = ("CY", "Cl", "Cn")
 AXIS_NAME = {"CX": "lon", "CZ": "lon", "Cm": "pitch", "CY": "lat", "Cl": "roll", "Cn": "yaw"}
 SURFACE_AXES = {"de": LON, "da": LAT, "dr": LAT}
 DELAY_GRID_S = np.arange(0.0, 0.3001, 0.002)
-G0 = 32.17404855643
 
 
 @dataclass(frozen=True)

@@ -22,8 +22,8 @@ import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_forward_selection
 from harness.diagnosis.prepare import Prepared
+from models.constants import G0_FPS2 as G0
 
-G0 = 32.17404855643
 EARTH_RADIUS_FT = 20_925_646.3
 BIAS_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "phi", "theta", "ax", "ay", "az")
 SCALE_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "ax", "ay", "az")
