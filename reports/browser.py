@@ -119,7 +119,7 @@ def _run(argv: list[str], timeout: float, what: str) -> bytes:
 
 
 def dump_dom(html_path: str | Path, *, timeout: float = DEFAULT_TIMEOUT_S,
-             chromium: str | None = None) -> str:
+             chromium: str | None = None, window: tuple[int, int] | None = None) -> str:
     """Load a local HTML file in headless Chromium and return the DOM after scripts ran.
 
     Parameters
@@ -129,6 +129,9 @@ def dump_dom(html_path: str | Path, *, timeout: float = DEFAULT_TIMEOUT_S,
         Seconds before Chromium is killed (default 60).
     chromium : str, optional
         The executable; found with :func:`find_chromium` when not given.
+    window : (int, int), optional
+        The window's width and height in CSS pixels (Chromium's default when not given), for
+        checks of the layout at a given screen size.
 
     Returns
     -------
@@ -146,7 +149,8 @@ def dump_dom(html_path: str | Path, *, timeout: float = DEFAULT_TIMEOUT_S,
     exe = _require_chromium(chromium)
     with tempfile.TemporaryDirectory(prefix="sidbench-chromium-",
                                      ignore_cleanup_errors=True) as profile:
-        argv = [exe, *chromium_args(profile), "--dump-dom", url]
+        size = [f"--window-size={int(window[0])},{int(window[1])}"] if window else []
+        argv = [exe, *chromium_args(profile), *size, "--dump-dom", url]
         out = _run(argv, timeout, f"load {html_path}")
     text = out.decode("utf-8", "replace")
     if not text.strip():

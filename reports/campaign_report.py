@@ -7,8 +7,9 @@ import pandas as pd
 
 from reports import figures as F
 from reports.campaign_setup import read_setup
-from reports.findings import COVERAGE_BAND, Findings, case_columns, find, status_of
-from reports.lead import efficiency_note, findings_section, lead_lines, setup_section, status_note
+from reports.findings import (COVERAGE_BAND, Findings, case_columns, efficiency_note, find, one_per_estimate,
+                              status_of)
+from reports.lead import findings_section, lead_lines, setup_section, status_note
 from reports.load import CampaignOutput, provenance
 from reports.render import Report, Section, Table
 
@@ -17,9 +18,10 @@ SE_RATIO_BAND: tuple[float, float] = (0.8, 1.25)
 """Standard-error ratios counted honest enough not to flag (a 25 % error either way)."""
 GATE_KEYS: tuple[str, ...] = ("noise", "method", "errors", "maneuver", "parameter")
 """The columns that name a gated cell in the nightly gate table."""
-_SCORE_COLUMNS = {"method": "method", "errors": "errors", "parameter": "parameter", "truth": "truth",
-                  "bias_pct": "bias %", "bias_z": "bias z", "rmse": "RMSE", "se_ratio": "SE ratio",
-                  "coverage": "coverage"}
+_ACCURACY_COLUMNS = {"method": "method", "parameter": "parameter", "truth": "truth", "mean": "mean",
+                     "bias_pct": "bias %", "bias_z": "bias z", "rmse": "RMSE", "efficiency": "efficiency"}
+_HONESTY_COLUMNS = {"method": "method", "errors": "errors", "parameter": "parameter", "mean_se": "mean SE",
+                    "std": "scatter", "se_ratio": "SE ratio", "coverage": "coverage"}
 _SUMMARY_COLUMNS = {"noise": "noise", "method": "method", "errors": "errors", "parameters": "parameters",
                     "median_coverage": "median coverage", "median_abs_bias_z": "median |bias z|",
                     "worst_abs_bias_z": "worst |bias z|", "median_rel_rmse_pct": "median relative RMSE %",
@@ -34,69 +36,89 @@ def _failed_cells(gates: pd.DataFrame | None, kind: str) -> set[tuple]:
     return {tuple(r[k] for k in GATE_KEYS) for _, r in g.iterrows()}
 
 
-def _score_frame(s: pd.DataFrame) -> pd.DataFrame:
-    """The columns that fit a 1280 px page: the varying case columns, method, errors, parameter,
-    truth, bias, RMSE, SE ratio, coverage with its interval, and efficiency when there is one."""
+def _key(r: pd.Series) -> tuple:
+    return tuple(r.get(k) for k in GATE_KEYS)
+
+
+def _accuracy_frame(s: pd.DataFrame) -> pd.DataFrame:
+    """The varying case columns, method, parameter, truth, mean, bias, RMSE and efficiency (when
+    there is one): what the estimates do, the same for every error type."""
     cases = [c for c in case_columns(s) if c in s]
-    frame = s[cases + [c for c in _SCORE_COLUMNS if c in s]].rename(columns=_SCORE_COLUMNS)
+    cols = [c for c in _ACCURACY_COLUMNS if c in s and (c != "efficiency" or np.isfinite(s[c].astype(float)).any())]
+    return s[cases + cols].rename(columns=_ACCURACY_COLUMNS)
+
+
+def _honesty_frame(s: pd.DataFrame) -> pd.DataFrame:
+    """The varying case columns, method, errors, parameter, mean reported standard error, scatter,
+    their ratio, coverage and its exact 95 % binomial interval."""
+    cases = [c for c in case_columns(s) if c in s]
+    frame = s[cases + [c for c in _HONESTY_COLUMNS if c in s]].rename(columns=_HONESTY_COLUMNS)
     if {"coverage_lo", "coverage_hi"} <= set(s):
         frame["95 % interval"] = [f"[{lo:.2f}, {hi:.2f}]" if np.isfinite(lo) and np.isfinite(hi) else "—"
                                   for lo, hi in zip(s["coverage_lo"], s["coverage_hi"])]
-    if "efficiency" in s and np.isfinite(s["efficiency"].astype(float)).any():
-        frame["efficiency"] = s["efficiency"]
     return frame
 
 
-def _highlights(s: pd.DataFrame, bias_limit: float, gates: pd.DataFrame | None) -> tuple:
-    """Red: a finding (bias beyond the limit, coverage interval outside the band), or with gates
-    a gate failure only; amber: a departure from nominal that is not a failure (or not gated)."""
-    gated = gates is not None
-    failed_bias, failed_cov = _failed_cells(gates, "bias"), _failed_cells(gates, "coverage")
+def _bias_highlights(s: pd.DataFrame, bias_limit: float, gates: pd.DataFrame | None) -> tuple:
+    """Red: a bias beyond the limit (with gates: only a failed bias gate; amber otherwise)."""
+    failed = _failed_cells(gates, "bias")
+    hl = []
+    for i, r in s.iterrows():
+        z = float(r.get("bias_z", np.nan))
+        if np.isfinite(z) and abs(z) > bias_limit:
+            hl.append((i, "bias z", "bad" if gates is None or _key(r) in failed else "warn"))
+    return tuple(hl)
+
+
+def _honesty_highlights(s: pd.DataFrame, gates: pd.DataFrame | None) -> tuple:
+    """Red: a coverage interval wholly outside the band (with gates: only a failed coverage gate);
+    amber: an interval excluding 0.95 otherwise, or a standard-error ratio outside its band."""
+    failed = _failed_cells(gates, "coverage")
     lo_band, hi_band = COVERAGE_BAND
     hl = []
     for i, r in s.iterrows():
-        key = tuple(r.get(k) for k in GATE_KEYS)
-        z, lo, hi = (float(r.get(k, np.nan)) for k in ("bias_z", "coverage_lo", "coverage_hi"))
-        if np.isfinite(z) and abs(z) > bias_limit:
-            hl.append((i, "bias z", "bad" if not gated or key in failed_bias else "warn"))
+        lo, hi = float(r.get("coverage_lo", np.nan)), float(r.get("coverage_hi", np.nan))
         if np.isfinite(lo) and np.isfinite(hi) and (hi < 0.95 or lo > 0.95):
-            outside = hi < lo_band or lo > hi_band
-            hl.append((i, "coverage", "bad" if (key in failed_cov if gated else outside) else "warn"))
+            bad = _key(r) in failed if gates is not None else (hi < lo_band or lo > hi_band)
+            hl.append((i, "coverage", "bad" if bad else "warn"))
         ratio = float(r.get("se_ratio", np.nan))
         if np.isfinite(ratio) and not SE_RATIO_BAND[0] <= ratio <= SE_RATIO_BAND[1]:
             hl.append((i, "SE ratio", "warn"))
     return tuple(hl)
 
 
-def score_table(scores: pd.DataFrame, bias_limit: float, gates: pd.DataFrame | None = None,
-                title: str = "Scores") -> Table:
-    """Scores with the cells that break a claim highlighted (see :func:`_highlights`).
+def _rows_note(shown: int, total: int) -> str:
+    return (f" Showing the first {shown} of {total} rows; every number is in the JSON report."
+            if total > shown else "")
 
-    Parameters
-    ----------
-    scores : DataFrame
-        The score rows (parameters with a truth).
-    bias_limit : float
-        |bias_z| beyond which a bias is a finding (:attr:`reports.findings.Findings.bias_limit`).
-    gates : DataFrame, optional
-        The nightly gate table; with it only gate failures are red, other departures amber.
-    """
+
+def accuracy_table(scores: pd.DataFrame, bias_limit: float, gates: pd.DataFrame | None = None) -> Table:
+    """One row per cell (error types collapsed: they share the estimates) and parameter: truth,
+    mean, bias, RMSE, efficiency; a bias beyond ``bias_limit`` highlighted (with ``gates``, the
+    nightly gate table, only a failed gate is red)."""
+    every = one_per_estimate(scores)
+    s = every.head(MAX_TABLE_ROWS).reset_index(drop=True)
+    red = ("Red: a failed bias gate (other cells are not gated: amber at most)" if gates is not None else
+           f"Red: |bias| beyond {bias_limit:.2f} Monte Carlo standard errors (Bonferroni, 1 % family-wise)")
+    caption = f"One row per cell and parameter; error types share the estimates, so each appears once. {red}."
+    note = efficiency_note(scores)
+    caption += (" " + note if note else "") + _rows_note(len(s), len(every))
+    return Table("Scores: accuracy", _accuracy_frame(s), caption, _bias_highlights(s, bias_limit, gates))
+
+
+def honesty_table(scores: pd.DataFrame, gates: pd.DataFrame | None = None) -> Table:
+    """One row per cell and parameter: the reported standard errors against the scatter, and the
+    coverage of the ±2σ intervals with its exact binomial interval."""
     s = scores.reset_index(drop=True).head(MAX_TABLE_ROWS)
-    frame = _score_frame(s)
     n = sorted({int(x) for x in scores["n"].dropna()}) if "n" in scores else []
     lo, hi = COVERAGE_BAND
-    red = ("Red: a gate failure (the other cells are not gated: amber at most)" if gates is not None else
-           f"Red: |bias| beyond {bias_limit:.2f} Monte Carlo standard errors or a coverage interval wholly "
-           f"outside [{lo:.2f}, {hi:.2f}]")
-    caption = (f"One row per cell and parameter ({'/'.join(map(str, n)) or '?'} realizations). {red}; amber: "
-               f"coverage interval excluding 0.95, standard-error ratio outside [{SE_RATIO_BAND[0]}, "
-               f"{SE_RATIO_BAND[1]}], or a departure not gated.")
-    note = efficiency_note(scores)
-    if note:
-        caption += " " + note
-    if len(scores) > MAX_TABLE_ROWS:
-        caption += f" Showing the first {MAX_TABLE_ROWS} of {len(scores)} rows; every number is in the JSON report."
-    return Table(title, frame, caption, _highlights(s, bias_limit, gates))
+    red = ("Red: a failed coverage gate (other cells are not gated: amber at most)" if gates is not None else
+           f"Red: a coverage whose 95 % interval lies wholly outside [{lo:.2f}, {hi:.2f}]")
+    caption = (f"Mean reported standard error against the scatter of the estimates (SE ratio 1 = honest bounds) and "
+               f"coverage of the ±2σ intervals over {'/'.join(map(str, n)) or '?'} realizations. {red}; amber: a "
+               f"coverage interval excluding 0.95 or an SE ratio outside [{SE_RATIO_BAND[0]}, {SE_RATIO_BAND[1]}]."
+               + _rows_note(len(s), len(scores)))
+    return Table("Scores: honesty of the bounds", _honesty_frame(s), caption, _honesty_highlights(s, gates))
 
 
 def method_summary(scores: pd.DataFrame) -> pd.DataFrame:
@@ -139,7 +161,8 @@ def campaign_sections(out: CampaignOutput, findings: Findings | None = None,
     f = findings if findings is not None else find(s)
     eff = efficiency_note(s)
     sections = [Section("Methods at a glance", (), (summary_table(s, f.bias_limit),) if not s.empty else ()),
-                Section("Accuracy and honesty", (eff,) if eff else (), (score_table(s, f.bias_limit, gates),),
+                Section("Accuracy and honesty", (eff,) if eff else (),
+                        (accuracy_table(s, f.bias_limit, gates), honesty_table(s, gates)),
                         _figs(F.fig_bias(s), F.fig_coverage(s), F.fig_se_ratio(s), F.fig_efficiency(s),
                               F.fig_scatter(out.results, s)))]
     if "max_corr" in s and s["loop"].nunique() > 2:

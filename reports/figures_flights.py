@@ -20,6 +20,11 @@ EXCURSIONS = (("max_dalpha_deg", "largest |Δα| (deg)"), ("max_dbeta_deg", "lar
               ("max_dnz_g", "largest |Δn_z| (g)"), ("max_dV_fps", "largest |ΔV| (ft/s)"))
 MAX_FLIGHTS = 6
 MAX_POINTS = 4000
+STILL_BELOW: float = 1e-3
+"""A channel whose peak-to-peak stays below this (in its own unit: deg, deg/s, ft/s, g) over every
+flight shown is left out of the figures: far below any sensor's resolution (the ``white``
+preset's smallest σ is 0.05° on the surfaces, ``harness/noise_presets.py``), so nothing an
+estimator could use (β, p, r, δa, δr on a pitch-only maneuver)."""
 
 
 def _flight_list(flights: pd.DataFrame, max_flights: int) -> tuple[list[str], int]:
@@ -30,6 +35,20 @@ def _flight_list(flights: pd.DataFrame, max_flights: int) -> tuple[list[str], in
 def _thin(g: pd.DataFrame) -> pd.DataFrame:
     step = max(1, len(g) // MAX_POINTS)
     return g.iloc[::step]
+
+
+def _moves(x: pd.Series) -> bool:
+    """True when the channel's peak-to-peak reaches :data:`STILL_BELOW`."""
+    v = x.to_numpy(float)
+    v = v[np.isfinite(v)]
+    return bool(v.size) and float(np.ptp(v)) >= STILL_BELOW
+
+
+def _departs(x: pd.Series) -> bool:
+    """True when some excursion reaches :data:`STILL_BELOW`."""
+    v = np.abs(x.to_numpy(float))
+    v = v[np.isfinite(v)]
+    return bool(v.size) and float(v.max()) >= STILL_BELOW
 
 
 def fig_time_histories(flights: pd.DataFrame | None, max_flights: int = MAX_FLIGHTS) -> FigureOut | None:
@@ -45,7 +64,9 @@ def fig_time_histories(flights: pd.DataFrame | None, max_flights: int = MAX_FLIG
     Returns
     -------
     FigureOut or None
-        A 3 × 3 grid: δe, δa, δr; α, β, V; q, p, r against time.
+        Up to a 3 × 3 grid (δe, δa, δr; α, β, V; q, p, r against time) of the channels that
+        move; channels that stay at trim (:data:`STILL_BELOW`) are left out and named in the
+        caption.
     """
     if is_empty(flights, ["flight", "t_s"]):
         return None
@@ -55,20 +76,25 @@ def fig_time_histories(flights: pd.DataFrame | None, max_flights: int = MAX_FLIG
     names, total = _flight_list(flights, max_flights)
     fl = numeric(flights[flights["flight"].astype(str).isin(names)], ["t_s"] + [c[0] for c in chans])
     fl["flight"] = fl["flight"].astype(str)
-    fig = new_figure(7.6)
-    axes = fig.subplots(3, 3, sharex=True).ravel()
+    moving = [c for c in chans if _moves(fl[c[0]])]
+    still = [c[1] for c in chans if c not in moving]
+    if not moving:
+        return None
+    ncols = min(3, len(moving))
+    nrows = -(-len(moving) // ncols)
+    fig = new_figure(1.4 + 2.1 * nrows)
+    axes = fig.subplots(nrows, ncols, sharex=True, squeeze=False).ravel()
     groups = {k: _thin(g.sort_values("t_s")) for k, g in fl.groupby("flight", sort=False)}
-    for ax, (col, sym, unit) in zip(axes, CHANNELS):
-        if col not in fl or not np.isfinite(fl[col].to_numpy(float)).any():
-            ax.text(0.5, 0.5, "not recorded", ha="center", va="center", transform=ax.transAxes, fontsize=SMALL)
-        else:
-            for i, name in enumerate(names):
-                g = groups.get(name)
-                if g is not None:
-                    ax.plot(g["t_s"], g[col], color=PALETTE[i % len(PALETTE)], linewidth=1.1, label=name)
+    for ax, (col, sym, unit) in zip(axes, moving):
+        for i, name in enumerate(names):
+            g = groups.get(name)
+            if g is not None:
+                ax.plot(g["t_s"], g[col], color=PALETTE[i % len(PALETTE)], linewidth=1.1, label=name)
         ax.set_ylabel(f"{sym} ({unit})", fontsize=FONT)
         style_axes(ax)
-    for ax in axes[6:]:
+    for ax in axes[len(moving):]:
+        ax.set_visible(False)
+    for ax in axes[max(0, len(moving) - ncols):len(moving)]:
         ax.set_xlabel("time (s)", fontsize=FONT)
     handles, labels = axes[0].get_legend_handles_labels()
     if not handles:
@@ -87,10 +113,13 @@ def fig_time_histories(flights: pd.DataFrame | None, max_flights: int = MAX_FLIG
             k = max(ex, key=ex.get)
             big = f" The largest angle-of-attack excursion is {fmt(ex[k], 2)}° ({k})."
     more = f" Only the first {len(names)} of {total} flights are shown." if total > len(names) else ""
-    caption = ("Top row: the surface deflections each maneuver applies; below: the aircraft's responses, all as "
-               "recorded (clean). Check that every surface an equation needs moves, and that the responses stay "
-               "small enough for linear models." + big + more)
-    alt = f"Nine line charts against time (δe, δa, δr, α, β, V, q, p, r) overlaying {len(names)} flights."
+    left = (f" {', '.join(still)} stay at trim on {'this maneuver' if len(names) == 1 else 'these maneuvers'} and "
+            "are left out." if still else "")
+    caption = ("The surface deflections each maneuver applies, then the aircraft's responses, all as recorded "
+               "(clean). Check that every surface an equation needs moves, and that the responses stay small enough "
+               "for linear models." + left + big + more)
+    alt = (f"{len(moving)} line charts against time ({', '.join(c[1] for c in moving)}) overlaying "
+           f"{len(names)} flights.")
     return done(fig, "time_histories", caption, alt)
 
 
@@ -227,17 +256,21 @@ def fig_excursions(results: pd.DataFrame | None) -> FigureOut | None:
     table = ex.pivot_table(index="label", columns="parameter", values="estimate", aggfunc="max", sort=False)
     total = len(table)
     table = table.iloc[:30]
-    fig = new_figure(1.0 + 2 * (0.8 + 0.22 * len(table)))
-    axes = fig.subplots(2, 2, sharey=True).ravel()
+    shown = [(p, title) for p, title in EXCURSIONS if p in table and _departs(table[p])]
+    if not shown:
+        return None
+    ncols = min(2, len(shown))
+    nrows = -(-len(shown) // ncols)
+    fig = new_figure(1.0 + nrows * (0.8 + 0.22 * len(table)))
+    axes = fig.subplots(nrows, ncols, sharey=True, squeeze=False).ravel()
     y = np.arange(len(table))
-    for ax, (p, title), color in zip(axes, EXCURSIONS, PALETTE):
-        if p in table:
-            v = table[p].to_numpy(float)
-            ax.barh(y, np.where(np.isfinite(v), np.abs(v), 0.0), color=color, height=0.7)
-        else:
-            ax.text(0.5, 0.5, "not recorded", ha="center", va="center", transform=ax.transAxes, fontsize=SMALL)
+    for ax, (p, title), color in zip(axes, shown, PALETTE):
+        v = table[p].to_numpy(float)
+        ax.barh(y, np.where(np.isfinite(v), np.abs(v), 0.0), color=color, height=0.7)
         ax.set_xlabel(title, fontsize=FONT)
         style_axes(ax, "x")
+    for ax in axes[len(shown):]:
+        ax.set_visible(False)
     axes[0].set_yticks(y)
     axes[0].set_yticklabels(table.index, fontsize=SMALL)
     axes[0].invert_yaxis()
@@ -246,7 +279,11 @@ def fig_excursions(results: pd.DataFrame | None) -> FigureOut | None:
         k = table["max_dalpha_deg"].abs().idxmax()
         big = f" The largest angle-of-attack excursion is {fmt(abs(table.loc[k, 'max_dalpha_deg']), 2)}° ({k})."
     more = f" Only the first 30 of {total} flights are shown." if total > 30 else ""
+    still = [title.split(" (")[0].replace("largest ", "") for p, title in EXCURSIONS if (p, title) not in shown]
+    left = f" {', '.join(still)} stay at zero and are left out." if still else ""
     caption = ("Bars are each maneuver's largest departure from trim; large excursions carry the aircraft across "
-               "table breakpoints, where local and fitted truths differ and linear models strain." + big + more)
-    alt = f"Four horizontal bar charts of peak excursions (α, β, n_z, V) for {len(table)} maneuvers."
+               "table breakpoints, where local and fitted truths differ and linear models strain." + big + left
+               + more)
+    alt = (f"{len(shown)} horizontal bar charts of peak excursions "
+           f"({', '.join(t.split(' (')[0].replace('largest ', '') for _, t in shown)}) for {len(table)} maneuvers.")
     return done(fig, "excursions", caption, alt)

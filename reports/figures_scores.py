@@ -12,6 +12,7 @@ from reports.figures_common import (MARKERS, PANEL_COLS, SMALL, SPECIAL_METHODS,
                                     categories, collapse_errors, dodged, done, errors_rank, finite_scores, fmt,
                                     grid, is_empty, method_color, method_order, new_figure, numeric, panel_note,
                                     panels, style_axes)
+from reports.findings import efficiency_note
 
 
 def _layout(parts: list[tuple[str, pd.DataFrame]]) -> tuple[int, float]:
@@ -159,6 +160,11 @@ def fig_se_ratio(scores: pd.DataFrame | None) -> FigureOut | None:
     return done(fig, "se_ratio", caption, alt)
 
 
+def _above_one(scores: pd.DataFrame) -> str:
+    note = efficiency_note(scores)
+    return " " + note if note else ""
+
+
 def fig_efficiency(scores: pd.DataFrame | None) -> FigureOut | None:
     """Efficiency (Cramér-Rao variance over empirical variance) where a bound is known.
 
@@ -193,7 +199,7 @@ def fig_efficiency(scores: pd.DataFrame | None) -> FigureOut | None:
                (f" Median efficiency {fmt(med.iloc[0], 2)}." if len(med) else ""))
     caption = ("Efficiency is the Cramér-Rao variance divided by the variance of the estimates: 1 means a method "
                "extracts all the information in the data, 0.5 that its estimates scatter with twice the variance "
-               "of the bound." + verdict + panel_note(len(parts), total) + more + _notes(notes))
+               "of the bound." + verdict + _above_one(shown) + panel_note(len(parts), total) + more + _notes(notes))
     alt = f"Dot plot, log scale, of estimation efficiency per parameter for {', '.join(series)}."
     return done(fig, "efficiency", caption, alt)
 

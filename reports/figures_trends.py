@@ -202,7 +202,8 @@ def fig_trend(history: pd.DataFrame | None, nights: int = 30, nominal: float = 0
     agg = h.groupby(["series", "run_id"]).agg(cov=("coverage", "median"), z=("abs_z", "median"),
                                               method=("method", "first"), errors=("errors", "first")).reset_index()
     agg = agg.merge(runs, on="run_id")
-    dated = agg["when"].notna().all()
+    single = len(runs) == 1  # one night: a date axis would span microseconds; one labelled position instead
+    dated = bool(agg["when"].notna().all()) and not single
     if not dated:
         agg["when"] = agg["run_id"].map({r: i for i, r in enumerate(runs["run_id"])})
     fig = new_figure(6.2)
@@ -222,11 +223,15 @@ def fig_trend(history: pd.DataFrame | None, nights: int = 30, nominal: float = 0
     ax2.axhline(2.0, color="#444444", linestyle=":", linewidth=1.0)
     ax1.set_ylabel("median coverage", fontsize=FONT)
     ax2.set_ylabel("median |bias z|", fontsize=FONT)
-    ax2.set_xlabel("run start (UTC)" if dated else "run (oldest to newest)", fontsize=FONT)
+    ax2.set_xlabel("run start (UTC)" if dated or single else "run (oldest to newest)", fontsize=FONT)
     if dated:
         loc = AutoDateLocator()
         ax2.xaxis.set_major_locator(loc)
         ax2.xaxis.set_major_formatter(ConciseDateFormatter(loc))
+    elif single:
+        when = runs["when"].iloc[0]
+        ax2.set_xlim(-1.0, 1.0)
+        ax2.set_xticks([0.0], [f"{when:%Y-%m-%d %H:%M}" if pd.notna(when) else str(runs["run_id"].iloc[0])])
     for ax in (ax1, ax2):
         style_axes(ax)
     fig.legend(*ax1.get_legend_handles_labels(), loc="outside upper center", ncols=min(len(series), 5),
@@ -243,8 +248,11 @@ def fig_trend(history: pd.DataFrame | None, nights: int = 30, nominal: float = 0
                           f"{fmt(piv.loc[k, last], 2)}.")
     span = (f"{runs['when'].iloc[0]:%Y-%m-%d} to {runs['when'].iloc[-1]:%Y-%m-%d}" if dated
             else f"{len(runs)} runs")
+    if single:
+        span = ax2.get_xticklabels()[0].get_text() + " UTC"
+        change = " Only one run so far: the trend starts with the next one." + change
     caption = (f"Median over parameters of each method's coverage (top, nominal {nominal:g} dashed) and of its "
-               f"|bias| in Monte Carlo standard errors (bottom, 2 dotted), per nightly run ({len(runs)} runs, {span}); "
+               f"|bias| in Monte Carlo standard errors (bottom, 2 dotted), per nightly run ({len(runs)} run{'s' if len(runs) > 1 else ''}, {span}); "
                "a step down in coverage or up in |bias z| flags a regression." + change + more)
     alt = (f"Two line charts over {len(runs)} runs of median coverage and median absolute bias z for "
            f"{', '.join(series)}.")

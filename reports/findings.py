@@ -17,6 +17,7 @@ Rules, each a documented parameter:
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,8 +26,8 @@ import pandas as pd
 from harness.gates import family_z
 
 __all__ = ["BIAS_FALSE_ALARM", "COVERAGE_BAND", "MIN_REALIZATIONS", "METHOD_LABELS", "CASE_COLUMNS",
-           "Findings", "find", "bias_tests", "bias_findings", "coverage_failures", "case_columns",
-           "comparison", "method_label", "status_of"]
+           "Findings", "find", "one_per_estimate", "bias_tests", "bias_findings", "coverage_failures", "case_columns",
+           "comparison", "method_label", "status_of", "efficiency_note"]
 
 BIAS_FALSE_ALARM: float = 0.01
 """Family-wise false-alarm rate of the bias findings (the nightly ``unbiased`` gate's)."""
@@ -105,13 +106,19 @@ def _keys(scores: pd.DataFrame) -> list[str]:
     return [k for k in _KEYS if k in scores]
 
 
+def one_per_estimate(scores: pd.DataFrame) -> pd.DataFrame:
+    """The scores with one row per cell and parameter across error types (they change the
+    bounds, not the estimates), in the scores' order."""
+    return scores.drop_duplicates(_keys(scores))
+
+
 def bias_tests(scores: pd.DataFrame) -> pd.DataFrame:
     """One row per cell and parameter with a finite ``bias_z``, error types collapsed (they
     share the estimates), sorted by |bias_z| descending."""
     if scores.empty or "bias_z" not in scores:
         return scores.iloc[0:0].assign(abs_bias_z=pd.Series(dtype=float))
     s = scores[np.isfinite(scores["bias_z"].astype(float))]
-    s = s.drop_duplicates(_keys(s)).assign(abs_bias_z=lambda d: d["bias_z"].abs())
+    s = one_per_estimate(s).assign(abs_bias_z=lambda d: d["bias_z"].abs())
     return s.sort_values("abs_bias_z", ascending=False, kind="stable").reset_index(drop=True)
 
 
@@ -170,3 +177,26 @@ def status_of(findings: Findings | None, failed_gates: int = 0) -> str:
     if failed_gates:
         return "fail"
     return "findings" if findings is not None and findings.count else "ok"
+
+
+def efficiency_note(scores: pd.DataFrame) -> str:
+    """Why an efficiency above 1 (a scatter below the Cramér-Rao bound) is possible, when one
+    appears in ``scores``; else ''."""
+    if "efficiency" not in scores:
+        return ""
+    scores = one_per_estimate(scores)
+    e = scores["efficiency"].astype(float)
+    above = scores[np.isfinite(e) & (e > 1)]
+    if above.empty:
+        return ""
+    methods = list(dict.fromkeys(above["method"].astype(str)))
+    text = (f"Efficiency above 1 ({len(above)} cells: {', '.join(methods)}; up to {e[np.isfinite(e)].max():.2f}) "
+            "does not mean a method beat the Cramér-Rao bound: the bound is output error's, for its own measured "
+            "outputs and their noise, and does not limit equation-error methods, which fit coefficients carrying "
+            "the output noise the campaign adds to them.")
+    n = int(above["n"].min()) if "n" in above else 0
+    if n > 1:
+        text += (f" With {n} realizations the variance of the estimates is itself uncertain by "
+                 f"±{100 * math.sqrt(2 / (n - 1)):.0f} % (one standard error)"
+                 + (", so output error slightly above 1 is Monte Carlo scatter." if "oe" in methods else "."))
+    return text

@@ -96,6 +96,7 @@ tbody tr:nth-child(even) { background: var(--zebra); }
 tbody tr:last-child td, tbody tr:last-child th { border-bottom: 0; }
 tbody th { font-weight: 600; }
 .num { text-align: right; white-space: nowrap; }
+thead th.num { white-space: normal; }
 td.missing { color: var(--muted); }
 td.bad, th.bad { background: var(--bad-bg); color: var(--bad-fg); font-weight: 600; }
 td.good, th.good { background: var(--good-bg); color: var(--good-fg); font-weight: 600; }

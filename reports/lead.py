@@ -15,7 +15,7 @@ from reports.load import CampaignOutput
 from reports.render import Section, Table
 
 __all__ = ["MAX_CASE_LINES", "MAX_COVERAGE_GROUPS", "lead_lines", "status_note", "findings_section",
-           "setup_section", "efficiency_note", "few_realizations_note"]
+           "setup_section", "few_realizations_note"]
 
 MAX_CASE_LINES: int = 6
 """Cases compared in the lead's sentences (the comparison table holds them all)."""
@@ -251,21 +251,3 @@ def setup_section(out: CampaignOutput, setup: Setup) -> Section:
                   "Sensor noise levels are standard deviations (white unless stated); output noise is white noise "
                   "added to the equation-error dependent variables. Output error always sees the noisy recording.")
     return Section("Campaign set-up", tuple(paragraphs), (table,))
-
-
-def efficiency_note(scores: pd.DataFrame) -> str:
-    """Why an efficiency above 1 is possible, when one appears; else ''."""
-    if "efficiency" not in scores:
-        return ""
-    e = scores["efficiency"].astype(float)
-    above = scores[np.isfinite(e) & (e > 1)]
-    if above.empty:
-        return ""
-    n = int(above["n"].min()) if "n" in above else 0
-    spread = f" and with {n} realizations the scatter's variance is itself uncertain by ±{100 * math.sqrt(2 / (n - 1)):.0f} %" \
-        if n > 1 else ""
-    methods = ", ".join(dict.fromkeys(above["method"].astype(str)))
-    return (f"Efficiency above 1 ({len(above)} cells: {methods}, up to {e[np.isfinite(e)].max():.2f}) does not beat "
-            "the Cramér-Rao bound: the bound is output error's, for its measured outputs and their noise; "
-            "equation-error methods fit coefficients with the output noise the campaign added to them, other data "
-            f"that this bound does not limit{spread}.")

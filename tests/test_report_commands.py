@@ -37,7 +37,7 @@ def test_report_command_writes_three_formats(campaign_dir, capsys):
     out = capsys.readouterr().out
     assert "# Campaign report: report-test" in out
     html = (campaign_dir / "report.html").read_text()
-    for needle in ('id="table-scores"', "data:image/png;base64,", "<figcaption", "report-test", "Seed"):
+    for needle in ('id="table-scores-accuracy"', 'id="table-scores-honesty-of-the-bounds"', "data:image/png;base64,", "<figcaption", "report-test", "Seed"):
         assert needle in html, needle
     d = json.loads((campaign_dir / "report.json").read_text())
     assert d["kind"] == "campaign" and d["numbers"]["scores"] and d["provenance"]["seed"] == 3
@@ -76,4 +76,4 @@ def test_real_report_renders_in_headless_chromium(campaign_dir, tmp_path):
     body = parsed.body
     assert body.get("data-images") == "ok", body
     assert int(body.get("data-imagecount")) >= 8
-    assert {"table-methods", "table-scores"} <= parsed.ids
+    assert {"table-methods", "table-scores-accuracy", "table-scores-honesty-of-the-bounds"} <= parsed.ids
