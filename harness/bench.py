@@ -265,6 +265,25 @@ def diagnosis_rows(repeat: int) -> list[BenchRow]:
     return out
 
 
+def calibration_rows(repeat: int) -> list[BenchRow]:
+    """``calibrate``: ten scales from a 30 % wrong start, one 20 s F-16 recording, 2 workers
+    (harness/calibrate/benchcase.py; issue 15's bar: 20 s)."""
+    from harness.calibrate import calibrate
+    from harness.calibrate.benchcase import bench_parameters, bench_recording
+
+    rec, found = bench_recording(), {}
+
+    def run() -> None:
+        found["result"] = calibrate("f16", rec, bench_parameters(), workers=2, hold="sample")
+
+    seconds = best_of(run, min(repeat, 2))
+    r = found["result"]
+    worst = max(abs(e - 1.0) / s for e, s in zip(r.estimate, r.std_error))
+    return [BenchRow("calibrate F-16: 10 scales, one 20 s recording, 30 % wrong start", seconds, "s",
+                     f"{r.iterations} iterations, {r.flights} JSBSim flights, 2 workers; largest |error| "
+                     f"{worst:.1f} s.e.; target <= 20 s")]
+
+
 LARGE_ROWS = 10_000_000
 
 
@@ -358,7 +377,7 @@ def large_recording_rows(n: int = LARGE_ROWS) -> list[BenchRow]:
 def rows(repeat: int) -> list[BenchRow]:
     """All benchmark rows, in order."""
     return (flight_rows(repeat) + estimator_rows(repeat) + campaign_rows() + report_rows() + diagnosis_rows(repeat)
-            + large_recording_rows())
+            + calibration_rows(repeat) + large_recording_rows())
 
 
 def format_rows(table: list[BenchRow]) -> str:

@@ -233,6 +233,10 @@ def _parser() -> argparse.ArgumentParser:
     cal.add_argument("--mass", choices=("model", "recording"), default="model",
                      help="fly the model with its own mass properties or with the recording's (first sample) "
                           "(default: model)")
+    cal.add_argument("--surfaces", choices=("linear", "sample"), default="linear",
+                     help="the recorded surfaces between samples: linear (a continuously moving surface, flight data) "
+                          "or sample (each sample held until the next: a stepped input sampled at its edges, as "
+                          "simulated recordings are) (default: linear)")
     cal.add_argument("--workers", type=int, default=2, help="processes flying the perturbed flights (default 2)")
     cal.add_argument("--max-iterations", type=int, default=20, help="Gauss-Newton iterations at most (default 20)")
     cal.set_defaults(func=_calibrate)

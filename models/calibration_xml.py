@@ -284,11 +284,11 @@ def delays(adjustments: Sequence[Adjustment], values: Sequence[float]) -> dict[s
 
 
 def adjusted_tree(tree: ET.ElementTree, adjustments: Sequence[Adjustment], values: Sequence[float], *,
-                  refs: Mapping[str, float], surfaces: Mapping[str, str]) -> ET.ElementTree:
-    """A copy of ``tree`` with every adjustment at its value (delays excepted: see
-    :func:`with_actuator_delays`). ``refs`` are the trim references of the vocabulary terms
-    (``alpha``, ``dV``, ``de`` ...: :func:`models.hidden.add_hidden_aerodynamics`)."""
-    out = copy.deepcopy(tree)
+                  refs: Mapping[str, float], surfaces: Mapping[str, str], in_place: bool = False) -> ET.ElementTree:
+    """A copy of ``tree`` (``tree`` itself with ``in_place``) with every adjustment at its value
+    (delays excepted: see :func:`with_actuator_delays`). ``refs`` are the trim references of
+    the vocabulary terms (``alpha``, ``dV``, ``de`` ...: :func:`models.hidden.add_hidden_aerodynamics`)."""
+    out = tree if in_place else copy.deepcopy(tree)
     fns = functions(out)
     for a, v in zip(adjustments, values):
         if a.kind == "scale":

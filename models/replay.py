@@ -53,7 +53,7 @@ def trim_at(aircraft: Aircraft, ic: InitialCondition, refs: Mapping[str, float] 
 def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Mapping[str, np.ndarray], *,
            refs: Mapping[str, float] | None = None, sim_rate_hz: float = 120.0,
            wind_ned_fps: Mapping[str, np.ndarray] | None = None, root: Path | None = None,
-           name: str | None = None, delays_s: Mapping[str, float] | None = None
+           name: str | None = None, delays_s: Mapping[str, float] | None = None, hold: str = "linear"
            ) -> tuple[FlightHistory, TrimPoint]:
     """Fly ``aircraft`` from trim at ``ic`` with the recording's surface motions.
 
@@ -61,7 +61,11 @@ def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Ma
     ``root``/``name`` load another XML of the same aircraft (a calibrated copy,
     :mod:`models.calibration_xml`) while ``aircraft`` still says how to trim and fly it.
     ``delays_s`` (surface -> s) feeds the aerodynamics δ(t − τ): the recorded motion shifted
-    by τ, linearly interpolated, so the response is continuous in τ.
+    by τ, so the response is continuous in τ. ``hold='linear'`` interpolates the recorded
+    surfaces linearly between samples (a continuously moving surface); ``hold='sample'`` holds
+    each sample until the next (a stepped input sampled at its edges, as the project's own
+    recordings are), each frame then getting the mean of that held signal over the frame
+    (:func:`held_mean`).
     Each surface moves by the recorded change from its first sample (linear interpolation
     between samples onto the simulation frames), about the model's own trim position: a
     model that needs another trim deflection still starts in equilibrium.
@@ -81,13 +85,41 @@ def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Ma
     rel = t - t[0]
     late = dict(delays_s or {})
 
+    if hold not in ("linear", "sample"):
+        raise ValueError(f"hold must be 'linear' or 'sample', not {hold!r}")
+
     def deflections(tf: np.ndarray) -> dict[str, np.ndarray]:
+        if hold == "sample":
+            w = float(tf[1] - tf[0]) if len(tf) > 1 else 1.0
+            return {s: held_mean(tf - late.get(s, 0.0), w, rel, x) for s, x in moves.items()}
         return {s: np.interp(tf - late.get(s, 0.0), rel, x) for s, x in moves.items()}
 
     dt = float(np.median(np.diff(t)))
     hist = fly(fdm, aircraft, tp, deflections, rel[-1], sample_rate_hz=1.0 / dt, sim_rate_hz=sim_rate_hz,
                wind_ned_fps=wind_ned_fps)
     return hist, tp
+
+
+def held_mean(a: np.ndarray, w: float, t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Mean over [a, a + w) of the signal that holds each sample x_k from t_k to t_{k+1}
+    (x_0 before t_0, the last sample after the end): [F(a + w) − F(a)]/w with F its integral,
+    piecewise linear through F(t_k) = Σ_{i<k} x_i (t_{i+1} − t_i). Continuous in a (so in a
+    delay that shifts it).
+
+    The flight loop applies the value computed at a frame's time t_f over the step that ends
+    at t_f (:func:`models.flight.fly`): with ``a`` = t_f and ``w`` = the frame step, a stepped
+    input whose edges fall on samples is replayed exactly as it was flown."""
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    F = np.concatenate([[0.0], np.cumsum(x[:-1] * np.diff(t))])
+
+    def integral(s: np.ndarray) -> np.ndarray:
+        inside = np.interp(s, t, F)
+        before = x[0] * (s - t[0])
+        after = F[-1] + x[-1] * (s - t[-1])
+        return np.where(s < t[0], before, np.where(s > t[-1], after, inside))
+
+    return (integral(a + w) - integral(a)) / w
 
 
 @dataclass(frozen=True)

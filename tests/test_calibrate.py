@@ -49,13 +49,14 @@ def _inputs() -> tuple[Sequence, Sequence]:
 
 @pytest.fixture(scope="module")
 def recordings(tmp_path_factory) -> dict[str, Path]:
-    """Identification and validation recordings of the concealed aircraft, 25 Hz, realistic noise."""
+    """Identification and validation recordings of the concealed aircraft, realistic noise, at
+    50 Hz: the inputs' edges fall on samples, so ``--surfaces sample`` replays them exactly."""
     folder = tmp_path_factory.mktemp("calibrate")
     truth = _truth_aircraft(folder / "truth")
     out = {}
     for (role, inp), seed in zip(zip(("identification", "validation"), _inputs()), NOISE_SEEDS):
         rec = fly_maneuver(FlightSpec(input=inp, aircraft=truth, duration_s=max(12.0, inp.duration_s),
-                                      sample_rate_hz=25.0, condition=CONDITION))
+                                      sample_rate_hz=50.0, condition=CONDITION))
         out[role] = write_recording(apply_noise(rec, preset("realistic"), seed), folder / f"{role}.csv")
     return out
 
@@ -65,7 +66,8 @@ def test_known_answer_in_the_loop(recordings, tmp_path, capsys):
     RMS error of the affected channels falls by at least 50 %; the written files."""
     out = tmp_path / "cal"
     code = main(["calibrate", "--model", "f16", "--recording", str(recordings["identification"]),
-                 "--validation", str(recordings["validation"]), "--parameters", ",".join(TRUTH), "--out", str(out)])
+                 "--validation", str(recordings["validation"]), "--parameters", ",".join(TRUTH), "--surfaces", "sample",
+                 "--out", str(out)])
     assert code == 0, capsys.readouterr().err
     doc = json.loads((out / "calibration.json").read_text())
     assert list(doc)[:8] == ["parameters", "outputs", "fit_before", "fit_after", "iterations", "converged",

@@ -15,7 +15,8 @@ def cmd_calibrate(args: argparse.Namespace, write_report: Callable[[Path], objec
     harness never imports the reports package), OUT/report.html."""
     outputs = tuple(s.strip() for s in args.outputs.split(",") if s.strip()) if args.outputs else None
     result = calibrate(args.model, args.recording, args.parameters, validation=args.validation, outputs=outputs,
-                       workers=args.workers, mass=args.mass, max_iterations=args.max_iterations)
+                       workers=args.workers, mass=args.mass, max_iterations=args.max_iterations,
+                       hold=args.surfaces)
     doc = write_calibration(result, Path(args.out))
     if write_report is not None:
         write_report(Path(args.out))

@@ -2,6 +2,8 @@
 measured outputs, and one flight of the adjusted aircraft (the unit of parallel work)."""
 from __future__ import annotations
 
+import contextlib
+import os
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -20,6 +22,8 @@ from models.replay import InitialCondition, initial_condition, replay
 from models.trim import TrimError
 
 SURFACES = ("de", "da", "dr")
+START_WINDOW_S = 0.5
+HOLDS = ("linear", "sample")
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
 UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi": "rad", "theta": "rad",
          "V": "fps", "ax": "g", "ay": "g", "az": "g"}
@@ -82,6 +86,7 @@ class Maneuver:
     ic: InitialCondition
     outputs: tuple[str, ...]
     z: np.ndarray
+    hold: str = "linear"  # how the surfaces are replayed between samples (models.replay.replay)
 
     @property
     def dt(self) -> float:
@@ -97,9 +102,22 @@ def _altitude(rec) -> np.ndarray:
     raise CalibrationError(f"recording {rec.name!r} has neither an altitude (h) nor qbar and V to start the model at")
 
 
-def maneuver(rec, outputs: tuple[str, ...] | None = None) -> Maneuver:
+def steady_start(x: np.ndarray, t: np.ndarray, window_s: float = START_WINDOW_S) -> np.ndarray:
+    """``x`` with its first sample replaced by the median of its first ``window_s`` seconds.
+
+    The replay moves each surface by its recorded change from the first sample
+    (:func:`models.replay.replay`): with a noisy potentiometer, that sample's noise would
+    become a constant deflection for the whole flight (0.05° of rudder is a steady sideslip).
+    """
+    k = max(1, int(np.ceil(window_s / float(np.median(np.diff(t))))))
+    out = np.array(x, dtype=float)
+    out[0] = float(np.median(out[:k]))
+    return out
+
+
+def maneuver(rec, outputs: tuple[str, ...] | None = None, hold: str = "linear") -> Maneuver:
     """A :class:`Maneuver` of a recording; ``outputs`` the channels to match (default: those of
-    :data:`OUTPUTS` it has).
+    :data:`OUTPUTS` it has); ``hold`` 'linear' or 'sample' (:func:`models.replay.replay`).
 
     Raises
     ------
@@ -112,6 +130,8 @@ def maneuver(rec, outputs: tuple[str, ...] | None = None) -> Maneuver:
     if missing:
         raise CalibrationError(f"recording {rec.name!r} lacks the channels {', '.join(missing)}: the model is "
                                "started from V, α (and h) and driven by the recorded surfaces")
+    if hold not in HOLDS:
+        raise CalibrationError(f"--surfaces must be one of {HOLDS}, not {hold!r}")
     if outputs is None:
         outputs = tuple(o for o in OUTPUTS if rec.has(o))
     absent = [o for o in outputs if not rec.has(o)]
@@ -120,10 +140,10 @@ def maneuver(rec, outputs: tuple[str, ...] | None = None) -> Maneuver:
                                f"(it has {', '.join(o for o in OUTPUTS if rec.has(o)) or 'none of them'})")
     t = rec.t
     ic = initial_condition(t, rec.channel("V"), rec.channel("alpha"), _altitude(rec))
-    surfaces = {s: rec.channel(s) for s in SURFACES if rec.has(s)}
+    surfaces = {s: steady_start(rec.channel(s), t) for s in SURFACES if rec.has(s)}
     z = np.column_stack([rec.channel(o) for o in outputs])
     return Maneuver(name=str(rec.name), t=np.asarray(t, dtype=float), surfaces=surfaces, ic=ic,
-                    outputs=tuple(outputs), z=z)
+                    outputs=tuple(outputs), z=z, hold=hold)
 
 
 @dataclass(frozen=True)
@@ -135,6 +155,7 @@ class Flight:
     values: tuple[float, ...]
     refs: tuple[tuple[str, float], ...]
     maneuver: Maneuver
+    scratch: str = ""  # a JSBSim root folder the flights may write into ("" : a temporary one each)
 
 
 def fly(job: Flight) -> np.ndarray | str:
@@ -147,12 +168,17 @@ def fly(job: Flight) -> np.ndarray | str:
     """
     b, m = job.base, job.maneuver
     aircraft = b.aircraft
-    tree = adjusted_tree(b.tree(), job.adjustments, job.values, refs=dict(job.refs), surfaces=aircraft.surfaces)
+    tree = adjusted_tree(b.tree(), job.adjustments, job.values, refs=dict(job.refs), surfaces=aircraft.surfaces,
+                         in_place=True)
     try:
-        with tempfile.TemporaryDirectory(prefix="sidbench-calibrate-") as d:
-            write_root(Path(d), b.name, tree, Path(b.source))
-            hist, _ = replay(aircraft, m.ic, m.t, m.surfaces, root=Path(d), name=b.name,
-                             delays_s=delays(job.adjustments, job.values))
+        with contextlib.ExitStack() as stack:
+            folder = job.scratch or stack.enter_context(tempfile.TemporaryDirectory(prefix="sidbench-calibrate-"))
+            # one aircraft name per process: concurrent workers never write each other's XML,
+            # and JSBSim has read it all by the time load_model returns
+            name = f"{b.name}-{os.getpid()}"
+            write_root(Path(folder), name, tree, Path(b.source))
+            hist, _ = replay(aircraft, m.ic, m.t, m.surfaces, root=Path(folder), name=name,
+                             delays_s=delays(job.adjustments, job.values), hold=m.hold)
     except (FlightError, TrimError) as exc:
         return str(exc)
     n = len(m.t)

@@ -117,11 +117,12 @@ def references(base: Base, m: Maneuver) -> dict[str, float]:
     return {"alpha": tp.alpha_rad, "dV": tp.V_fps, "de": tp.de_rad, "da": tp.da_rad, "dr": tp.dr_rad}
 
 
-def _evaluator(executor, base: Base, adjustments: tuple[Adjustment, ...], refs: dict, maneuvers: list[Maneuver]):
+def _evaluator(executor, base: Base, adjustments: tuple[Adjustment, ...], refs: dict, maneuvers: list[Maneuver],
+               scratch: str):
     refs_t = tuple(sorted(refs.items()))
 
     def evaluate(points):
-        items = [(k, Flight(base, adjustments, tuple(float(v) for v in th), refs_t, m))
+        items = [(k, Flight(base, adjustments, tuple(float(v) for v in th), refs_t, m, scratch))
                  for k, (th, m) in enumerate((th, m) for th in points for m in maneuvers)]
         out: list = [None] * len(items)
         for (k, _), y in executor.imap_unordered(fly_indexed, items):
@@ -153,7 +154,7 @@ def _series(maneuvers: list[Maneuver], smooth: list[np.ndarray], before, after) 
 
 def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str | Adjustment], *,
               validation=None, outputs: Sequence[str] | None = None, workers: int = 2, mass: str = "model",
-              max_iterations: int = 20) -> CalibrationResult:
+              max_iterations: int = 20, hold: str = "linear") -> CalibrationResult:
     """Calibrate ``aircraft`` (``f16``, ``737``, ``dhc6``, an XML path, or a :class:`Base`) to
     ``recordings`` (paths or :class:`~maneuvers.recording.Recording`, one or several).
 
@@ -167,6 +168,9 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
     workers : processes flying the perturbed flights (1: in this process).
     mass : ``'model'`` (the aircraft's own) or ``'recording'`` (the first recording's mass and
         inertia at its first sample, written into the XML).
+    hold : how the recorded surfaces are replayed between samples: ``'linear'`` (a surface that
+        moves continuously: flight data) or ``'sample'`` (each sample held until the next: a
+        stepped input sampled at its edges, as simulated recordings are).
 
     Raises
     ------
@@ -197,21 +201,21 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
                 raise CalibrationError(f"--mass recording: {exc}") from exc
         base = base_aircraft(str(aircraft), mp)
     check(base, adjustments)
-    ident = [maneuver(r, tuple(outputs) if outputs else None) for r in recs]
+    ident = [maneuver(r, tuple(outputs) if outputs else None, hold) for r in recs]
     outs = ident[0].outputs
-    ident = [maneuver(r, outs) for r in recs]
-    valid = [maneuver(r, outs) for r in vals]
+    ident = [maneuver(r, outs, hold) for r in recs]
+    valid = [maneuver(r, outs, hold) for r in vals]
     refs = references(base, ident[0])
     start = np.array([a.start for a in adjustments])
     typical = np.array([a.typical for a in adjustments])
     lower = np.array([a.lower for a in adjustments])
-    with make_executor(None, workers) as ex:
-        evaluate = _evaluator(ex, base, adjustments, refs, ident)
+    with tempfile.TemporaryDirectory(prefix="sidbench-calibrate-") as scratch, make_executor(None, workers) as ex:
+        evaluate = _evaluator(ex, base, adjustments, refs, ident, scratch)
         try:
             res = gauss_newton(evaluate, start, typical, lower, [m.z for m in ident], max_iterations=max_iterations)
         except RuntimeError as exc:
             raise CalibrationError(str(exc)) from exc
-        final = _evaluator(ex, base, adjustments, refs, ident + valid)([start, res.theta])
+        final = _evaluator(ex, base, adjustments, refs, ident + valid, scratch)([start, res.theta])
     n_id = len(ident)
     smooth = [smoothed(m.z, m.dt) for m in ident + valid]
     b_flights = [y if not isinstance(y, str) else None for y in final[0]]
@@ -225,7 +229,7 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
     allm = ident + valid
     series = {r: _series(allm[s], smooth[s], b_flights[s], a_flights[s]) for r, s in roles.items()}
     inputs = {"model": base.model, "mass": mass, "recordings": [m.name for m in ident],
-              "validation": [m.name for m in valid], "workers": workers, "max_iterations": max_iterations,
+              "validation": [m.name for m in valid], "workers": workers, "max_iterations": max_iterations, "surfaces": hold,
               "start_h_ft": ident[0].ic.h_ft, "start_V_fps": ident[0].ic.V_fps}
     return CalibrationResult(
         base=base, adjustments=adjustments, start=start, estimate=res.theta,
