@@ -2,11 +2,14 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
 from harness.cli import main
 from reports.browser import dump_dom
+from reports.figures import fig_excursions, fig_time_histories
+from reports.load import read_output
 from test_report_browser import CHECK_SCRIPT, _chromium, _parse
 
 CAMPAIGN = """
@@ -77,3 +80,61 @@ def test_real_report_renders_in_headless_chromium(campaign_dir, tmp_path):
     assert body.get("data-images") == "ok", body
     assert int(body.get("data-imagecount")) >= 8
     assert {"table-methods", "table-scores-accuracy", "table-scores-honesty-of-the-bounds"} <= parsed.ids
+
+
+WIDTH_SCRIPT = """<script>
+(function () {
+  function check() {
+    var wide = [], hidden = [], page = document.documentElement.clientWidth;
+    document.querySelectorAll(".table-scroll").forEach(function (box) {
+      if (box.scrollWidth > box.clientWidth + 1) {
+        var t = box.querySelector("table"); wide.push((t && t.id) || "?");
+      }
+    });
+    document.querySelectorAll("thead th").forEach(function (th) {
+      var text = th.textContent.trim();
+      if ((text === "SE ratio" || text === "coverage") && th.getBoundingClientRect().right > page) {
+        hidden.push(th.closest("table").id + ":" + text);
+      }
+    });
+    document.body.dataset.wide = wide.join(" ") || "none";
+    document.body.dataset.hidden = hidden.join(" ") || "none";
+    document.body.dataset.pagewidth = String(document.documentElement.scrollWidth);
+    document.body.dataset.viewport = String(page);
+  }
+  if (document.readyState === "complete") { check(); } else { window.addEventListener("load", check); }
+})();
+</script>
+"""
+
+
+def test_tables_fit_a_1280_px_window(campaign_dir, tmp_path):
+    """Every table of the real report fits a 1280 px window: no horizontal scrolling, the
+    standard-error ratio and coverage columns in view."""
+    chromium = _chromium()
+    if not (campaign_dir / "report.html").is_file():
+        assert main(["report", str(campaign_dir)]) == 0
+    html = (campaign_dir / "report.html").read_text(encoding="utf-8")
+    probe = tmp_path / "probe.html"
+    probe.write_text(html.replace("</body>", WIDTH_SCRIPT + "</body>"), encoding="utf-8")
+    body = _parse(dump_dom(probe, chromium=chromium, window=(1280, 900))).body
+    assert body.get("data-wide") == "none", body
+    assert body.get("data-hidden") == "none", body
+    assert int(body["data-pagewidth"]) <= int(body["data-viewport"]) <= 1280, body
+
+
+def test_pitch_only_campaign_leaves_out_still_channels_and_says_few_realizations(campaign_dir):
+    out = read_output(campaign_dir)
+    history = fig_time_histories(out.flights)
+    assert "β" not in history.alt and "δa" not in history.alt and {"δe", "α", "q"} <= set(
+        history.alt.split("(")[1].split(")")[0].split(", "))
+    left_out = re.search(r"([^.]*) stay at trim on this maneuver and are left out", history.caption)
+    assert left_out and "β" in left_out.group(1)
+    excursions = fig_excursions(out.results[out.results["method"] == "excursion"])
+    assert "β" not in excursions.alt
+    if not (campaign_dir / "report.json").is_file():
+        assert main(["report", str(campaign_dir)]) == 0
+    d = json.loads((campaign_dir / "report.json").read_text())
+    assert d["status"] in ("ok", "findings") and d["status_note"]
+    assert any("Only 4 realizations per cell (fewer than 30)" in line for line in d["summary"])
+    assert d["summary"][1].startswith("Flown: the JSBSim F-16 with exactly linear body-axis aerodynamics")
