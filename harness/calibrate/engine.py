@@ -245,8 +245,12 @@ def gauss_newton(evaluate: Evaluate, theta0: np.ndarray, typical: np.ndarray, lo
                 break
             lam /= 2
         if accepted is None:
+            left = float(np.max(np.abs(step[:p]) / se[:p]))
+            # the flights' own numerical noise (JSBSim's trim converges to a tolerance) leaves a
+            # floor under the cost: a step smaller than the estimates' uncertainty is at it
+            converged = left < 1.0
             notes.append(f"iteration {iterations}: no step along the Gauss-Newton direction lowered the cost "
-                         f"after {MAX_HALVINGS} halvings; stopped there")
+                         f"after {MAX_HALVINGS} halvings (the step left is {left:.2g} standard errors); stopped there")
             break
         th_t, b_t, y_t, pert, h_t = accepted
         if pert is None:
