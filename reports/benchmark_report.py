@@ -61,6 +61,21 @@ def breaking_points(s: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _display(frame: pd.DataFrame, caption: str) -> tuple[pd.DataFrame, str]:
+    """The frame without the case columns that hold one value (named in the caption instead), so
+    that the table fits a 1280 px page; the JSON numbers keep every column."""
+    same = [c for c in CASE if c in frame and frame[c].nunique(dropna=False) == 1 and len(frame)]
+    if not same:
+        return frame, caption
+    fixed = ", ".join(f"{c} {frame[c].iloc[0]}" for c in same)
+    return frame.drop(columns=same), (caption + " " if caption else "") + f"Every row: {fixed}."
+
+
+def _table(title: str, frame: pd.DataFrame, caption: str) -> Table:
+    shown, text = _display(frame, caption)
+    return Table(title, shown.reset_index(drop=True).rename(columns=lambda c: str(c).replace("_", " ")), text)
+
+
 def benchmark_report(outputs: list[CampaignOutput]) -> Report:
     s = _prepare(outputs)
     ov = overall(s)
@@ -75,9 +90,10 @@ def benchmark_report(outputs: list[CampaignOutput]) -> Report:
         Section("Overall ranking", ("Ranks are 1 for the best method in each case and parameter, averaged.",),
                 (Table("Methods", ov, "Lower ranks are better; coverage near 0.95 means honest bounds."),),
                 tuple(f for f in (F.fig_accuracy_vs_cost(s),) if f is not None)),
-        Section("Where each method breaks", (), (Table("Worst case per method and campaign", breaking_points(s),
-                                                       "The cell with the largest |bias| in Monte Carlo standard errors."),)),
-        Section("Best method per case and parameter", (), (Table("Rankings", rankings(s).head(300), ""),)),
+        Section("Where each method breaks", (), (_table("Worst case per method and campaign", breaking_points(s),
+                                                        "The cell with the largest |bias| in Monte Carlo standard "
+                                                        "errors."),)),
+        Section("Best method per case and parameter", (), (_table("Rankings", rankings(s).head(300), ""),)),
     ]
     numbers = {"overall": ov.replace({np.nan: None}).to_dict(orient="records"),
                "rankings": rankings(s).replace({np.nan: None}).to_dict(orient="records")}

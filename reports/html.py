@@ -19,7 +19,7 @@ from typing import Any
 
 from harness.atomic import write_text_atomic
 from reports.render import (HTML_MAX_ROWS, Report, Section, Table, anchors, png_size,
-                            provenance_items, table_view)
+                            provenance_items, split_label, table_view)
 
 __all__ = ["write_html", "html_text"]
 
@@ -136,6 +136,12 @@ def _e(text: Any) -> str:
     return escape(str(text), quote=True)
 
 
+def _summary_item(line: str) -> str:
+    """One lead line, its label (``'Largest bias'``) in bold."""
+    label, rest = split_label(line)
+    return f"<li><strong>{_e(label)}</strong>: {_e(rest)}</li>" if label else f"<li>{_e(line)}</li>"
+
+
 def _table_html(table: Table, table_id: str, number: int, max_rows: int | None) -> str:
     view = table_view(table, max_rows)
     long = " long" if len(view.rows) > 25 else ""
@@ -235,7 +241,7 @@ def html_text(report: Report, *, max_rows: int | None = HTML_MAX_ROWS) -> str:
     parts += ["</div>", f'<p class="kind">{_e(_KIND_LABELS.get(report.kind, report.kind))}</p>']
     if report.summary:  # the lead: what matters first, before where it came from
         parts.append('<ul class="summary" id="summary">')
-        parts += [f"<li>{_e(line)}</li>" for line in report.summary]
+        parts += [_summary_item(line) for line in report.summary]
         parts.append("</ul>")
     items = provenance_items(report.provenance)
     if items:

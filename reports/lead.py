@@ -55,10 +55,15 @@ def noise_short(noise: NoiseDef | None) -> str:
     return text
 
 
-def _case_label(row: pd.Series, cases: tuple[str, ...], noises: dict[str, NoiseDef]) -> str:
+def _case_label(row: pd.Series, cases: tuple[str, ...]) -> str:
     name = case_name(row, cases)
+    return f"{name[0].upper()}{name[1:]}"
+
+
+def _case_definition(row: pd.Series, cases: tuple[str, ...], noises: dict[str, NoiseDef]) -> str:
+    """`` (White sensor noise on the regressors, output σ Cm 0.0005.)`` or ''."""
     short = noise_short(noises.get(str(row.get("noise")))) if "noise" in cases else ""
-    return f"{name[0].upper()}{name[1:]}" + (f" ({short})" if short else "")
+    return f" ({short[0].upper()}{short[1:]}.)" if short else ""
 
 
 def _method_z(row: pd.Series, with_parameter: bool) -> str:
@@ -82,16 +87,18 @@ def _join(items: list[str]) -> str:
 
 
 def case_line(rows: pd.DataFrame, cases: tuple[str, ...], limit: float, noises: dict[str, NoiseDef]) -> str:
-    """One case: which methods are biased beyond the limit (with their worst parameter), which not."""
-    label = _case_label(rows.iloc[0], cases, noises)
+    """One case: which methods are biased beyond the limit (with their worst parameter), which
+    not, then what the case's noise is."""
+    label = _case_label(rows.iloc[0], cases)
+    definition = _case_definition(rows.iloc[0], cases, noises)
     beyond = rows["abs_bias_z"] > limit
     fine = [_method_z(r, False) for _, r in rows[~beyond].iterrows()]
     if not beyond.any():
-        return f"{label}: no method biased beyond {limit:.2f} standard errors ({_join(fine)})."
+        return f"{label}: no method biased beyond {limit:.2f} standard errors ({_join(fine)}).{definition}"
     text = f"{label}: {_join(_biased(rows[beyond]))}"
     if not fine:
-        return text + f", all beyond {limit:.2f}."
-    return text + f"; {_join(fine)} {'stays' if len(fine) == 1 else 'stay'} within {limit:.2f}."
+        return text + f", all beyond {limit:.2f}.{definition}"
+    return text + f"; {_join(fine)} {'stays' if len(fine) == 1 else 'stay'} within {limit:.2f}.{definition}"
 
 
 def _verdict(f: Findings) -> str:
@@ -123,8 +130,8 @@ def _coverage_line(f: Findings) -> str:
              for (m, e), g in groups.head(MAX_COVERAGE_GROUPS).iterrows()]
     more = f" and {len(groups) - MAX_COVERAGE_GROUPS} more methods" if len(groups) > MAX_COVERAGE_GROUPS else ""
     lo, hi = COVERAGE_BAND
-    return (f"Coverage of the ±2σ bounds outside [{lo:.2f}, {hi:.2f}] (95 % interval wholly outside): "
-            + "; ".join(parts) + more + ".")
+    return ("Coverage failures: " + "; ".join(parts) + more
+            + f" (±2σ bounds whose 95 % coverage interval lies wholly outside [{lo:.2f}, {hi:.2f}]).")
 
 
 def few_realizations_note(f: Findings) -> str:
@@ -139,7 +146,7 @@ def few_realizations_note(f: Findings) -> str:
 def _run_line(out: CampaignOutput) -> str:
     m = out.meta
     c = m["campaign"]
-    return (f"{c.get('cells', '?')} cells × {c.get('realizations', '?')} realizations, "
+    return (f"Run: {c.get('cells', '?')} cells × {c.get('realizations', '?')} realizations, "
             f"{m.get('estimates', len(out.results))} estimates in {m.get('wall_s', float('nan')):.1f} s on "
             f"{m.get('executor')}.")
 

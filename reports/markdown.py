@@ -10,7 +10,7 @@ import re
 from pathlib import Path
 
 from harness.atomic import write_text_atomic
-from reports.render import MARKDOWN_MAX_ROWS, Report, provenance_items, table_view
+from reports.render import MARKDOWN_MAX_ROWS, Report, provenance_items, split_label, table_view
 
 __all__ = ["markdown_text", "write_markdown"]
 
@@ -20,6 +20,12 @@ _SPECIAL = re.compile(r"([\\`*\[\]<>|])")
 def _md(text: object) -> str:
     """Escape Markdown/HTML punctuation and fold the text onto one line."""
     return _SPECIAL.sub(r"\\\1", " ".join(str(text).split()))
+
+
+def _summary_item(line: str) -> str:
+    """One lead line as a list item, its label (``'Largest bias'``) in bold."""
+    label, rest = split_label(line)
+    return f"- **{_md(label)}**: {_md(rest)}" if label else f"- {_md(line)}"
 
 
 def _provenance_lines(report: Report) -> list[str]:
@@ -64,7 +70,7 @@ def markdown_text(report: Report, *, html_name: str | None = None,
     lines = [f"# {_md(report.title)}", "",
              f"**Status: {icon} {status}**{note} · {_md(report.kind)} report", ""]
     if report.summary:
-        lines += [f"- {_md(line)}" for line in report.summary] + [""]
+        lines += [_summary_item(line) for line in report.summary] + [""]
     provenance = _provenance_lines(report)
     if provenance:
         lines += [line + "  " for line in provenance[:-1]] + [provenance[-1], ""]

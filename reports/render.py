@@ -31,7 +31,7 @@ __all__ = [
     "KINDS", "STATUSES", "HIGHLIGHT_CLASSES", "HTML_MAX_ROWS", "MARKDOWN_MAX_ROWS",
     "Table", "Section", "Report", "Cell", "TableView", "Anchors",
     "table_view", "anchors", "slugify", "format_number", "format_value", "json_value",
-    "jsonable", "png_size", "provenance_items",
+    "jsonable", "png_size", "provenance_items", "LABEL_MAX", "split_label",
 ]
 
 KINDS: tuple[str, ...] = ("campaign", "nightly", "benchmark", "maneuver-review", "diagnosis", "estimate")
@@ -45,6 +45,8 @@ HTML_MAX_ROWS: int = 300
 """Rows of one table shown in the HTML (and JSON) report; longer tables carry a note."""
 MARKDOWN_MAX_ROWS: int = 15
 """Rows of one table shown in the Markdown summary."""
+LABEL_MAX: int = 40
+"""A summary line starting with a label this short followed by ': ' shows the label in bold."""
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _FIGURE_ATTRIBUTES = ("name", "caption", "png", "alt")
@@ -646,3 +648,12 @@ def provenance_items(provenance: Mapping[str, Any]) -> list[tuple[str, str]]:
             continue
         items.append((str(key).replace("_", " ").capitalize(), format_value(value)))
     return items
+
+
+def split_label(line: str, max_chars: int = LABEL_MAX) -> tuple[str, str]:
+    """``('Largest bias', 'least squares ...')`` for ``'Largest bias: least squares ...'``: the
+    text before the first ``': '`` when it is at most ``max_chars`` long, else ``('', line)``."""
+    head, sep, rest = line.partition(": ")
+    if sep and head.strip() and len(head) <= max_chars:
+        return head, rest
+    return "", line

@@ -102,7 +102,8 @@ def test_lead_names_the_largest_bias_first(report):
     # the HTML's first list is the lead, before the provenance
     html = html_text(report)
     assert html.index('id="summary"') < html.index('id="provenance"')
-    assert html.index("Largest bias: least squares (ee-time)") < html.index("Noise clean")
+    assert html.index("<strong>Largest bias</strong>: least squares (ee-time)") < \
+        html.index("<strong>Noise clean</strong>")
 
 
 def test_the_lead_reads_the_numbers_the_scores_hold():

@@ -181,7 +181,7 @@ def test_html_structure_ids_and_provenance(written):
     for text in ("nightly-f16", "0123456789abcdef0123 (+dirty)", "20240611", "jsbsim 1.3.3",
                  "process, 2 workers", "2026-01-01T00:03:06+00:00", "3 min 5 s", "ab" * 32):
         assert text in html, text
-    assert "<li>stepwise: Cm_alpha missing &lt;NaN&gt;</li>" in html
+    assert "<li><strong>stepwise</strong>: Cm_alpha missing &lt;NaN&gt;</li>" in html
 
 
 def test_html_escapes_all_text(written):
