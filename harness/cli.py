@@ -225,7 +225,8 @@ def _parser() -> argparse.ArgumentParser:
     cal.add_argument("--parameters", required=True,
                      help="comma list: FUNCTION:scale or FUNCTION:increment (e.g. aero/coefficient/Cnb:scale), a "
                           "vocabulary term (Cm_alphadot, Cn_beta, Cl_beta_abs, ...), tau_de|tau_da|tau_dr, iyy:scale, "
-                          "cg_x:increment ...; NAME=VALUE sets the start")
+                          "cg_x:increment ...; NAME=VALUE sets the start; auto: the terms the diagnosis adds (run on "
+                          "the first recording and validation), auto=FINDINGS.json: an earlier diagnosis's")
     cal.add_argument("--out", required=True, help="output folder")
     cal.add_argument("--outputs", default=None,
                      help="comma list of channels matched (default: those of alpha,beta,p,q,r,phi,theta,V,ax,ay,az "

@@ -164,3 +164,18 @@ def test_a_recording_without_surfaces_is_refused(recordings, tmp_path):
     bare = type(rec)(data=data, meta=rec.meta, name="bare")
     with pytest.raises(CalibrationError, match="lacks the channels de|da|dr"):
         calibrate("f16", bare, "Cm_alphadot", workers=1)
+
+
+def test_auto_takes_the_terms_the_diagnosis_added(recordings, tmp_path):
+    """``--parameters auto=FINDINGS.json``: each aerodynamic or delay term of findings.json's
+    model, started at its size; sensor terms are left to the diagnosis."""
+    from harness.calibrate.auto import findings_parameters
+    findings = {"model": {"terms": [
+        {"effect": "unsteady_alphadot", "size": -2.5, "parameter": "Cm_alphadot"},
+        {"effect": "control_delay", "size": 0.07, "surface": "de", "parameter": "tau_de"},
+        {"effect": "sensor_bias", "size": 0.02, "channel": "alpha", "parameter": "bias_alpha"}]}}
+    assert findings_parameters(findings) == ["Cm_alphadot=-2.5", "tau_de=0.07"]
+    path = tmp_path / "findings.json"
+    path.write_text(json.dumps({"model": {"terms": findings["model"]["terms"][2:]}}))
+    with pytest.raises(CalibrationError, match="no aerodynamic or delay term"):
+        calibrate("f16", recordings["identification"], f"auto={path}", workers=1)

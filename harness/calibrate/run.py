@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from harness.calibrate.auto import auto_parameters
 from harness.calibrate.engine import gauss_newton
 from harness.calibrate.fitstats import channel_fit, smoothed
 from harness.calibrate.problem import (Base, CalibrationError, Flight, Maneuver, base_aircraft, check, fly_indexed,
@@ -161,7 +162,9 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
     Parameters
     ----------
     parameters : a comma list or a sequence of names (:mod:`models.calibration_xml`), or
-        :class:`Adjustment` objects.
+        :class:`Adjustment` objects; ``auto`` adds the terms the diagnosis adds to the aircraft
+        (run now on the first recording and validation), ``auto=FINDINGS.json`` those of an
+        earlier diagnosis (:mod:`harness.calibrate.auto`).
     validation : recordings the calibrated model is only flown on (a prediction).
     outputs : the channels matched (default: every one of alpha, beta, p, q, r, phi, theta, V,
         ax, ay, az the first recording has).
@@ -185,11 +188,16 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
         raise CalibrationError("calibrate needs at least one recording")
     if mass not in ("model", "recording"):
         raise CalibrationError(f"--mass must be 'model' or 'recording', not {mass!r}")
-    adjustments = tuple(a if isinstance(a, Adjustment) else None for a in _as_list(parameters)) \
-        if not isinstance(parameters, str) else ()
-    if isinstance(parameters, str) or any(a is None for a in adjustments):
-        adjustments = parse_parameters(parameters if isinstance(parameters, str) else ",".join(
-            p if isinstance(p, str) else p.name for p in parameters))
+    items = [s.strip() for s in parameters.split(",")] if isinstance(parameters, str) else _as_list(parameters)
+    auto: list[str] = []
+    for it in [i for i in items if isinstance(i, str) and (i == "auto" or i.startswith("auto="))]:
+        auto += auto_parameters(it, str(aircraft), _as_list(recordings)[0], next(iter(_as_list(validation)), None),
+                                mass)
+    items = [i for i in items if not (isinstance(i, str) and (i == "auto" or i.startswith("auto=")))] + auto
+    if all(isinstance(i, Adjustment) for i in items) and items:
+        adjustments = tuple(items)
+    else:
+        adjustments = parse_parameters(",".join(i if isinstance(i, str) else i.name for i in items if i))
     if isinstance(aircraft, Base):
         base = aircraft
     else:
@@ -229,7 +237,7 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
     allm = ident + valid
     series = {r: _series(allm[s], smooth[s], b_flights[s], a_flights[s]) for r, s in roles.items()}
     inputs = {"model": base.model, "mass": mass, "recordings": [m.name for m in ident],
-              "validation": [m.name for m in valid], "workers": workers, "max_iterations": max_iterations, "surfaces": hold,
+              "validation": [m.name for m in valid], "workers": workers, "max_iterations": max_iterations, "surfaces": hold, "auto": auto,
               "start_h_ft": ident[0].ic.h_ft, "start_V_fps": ident[0].ic.V_fps}
     return CalibrationResult(
         base=base, adjustments=adjustments, start=start, estimate=res.theta,
