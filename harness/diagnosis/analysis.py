@@ -7,11 +7,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from harness.diagnosis import candidates as cand
+from harness.diagnosis import rivals
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
                                           is_plausible, is_practical, kinematic_check, kinematic_residuals)
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
-from models.aircraft import Aircraft
+from models.aircraft import Aircraft, has_propeller
 from models.replay import AeroAlong, InitialCondition, aero_along
 from models.constants import G0_FPS2
 
@@ -181,6 +182,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             delays[s] = scan
     # 5. per-axis stepwise
     selections = {}
+    propeller = has_propeller(aircraft.model)
+    nuisances: dict[str, dict[str, np.ndarray]] = {}
     not_offered: dict[str, list[str]] = {}
     shares: dict[tuple[str, str], float] = {}
     inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
@@ -188,20 +191,37 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
                              for t in skipped]
-        if axis == "CX" and "thrust" not in p.raw:
-            # thrust held constant (not recorded): a jet's thrust changes with airspeed at a
-            # fixed throttle, and that change is what a CX drift term would fit
+        nuisance = _thrust_nuisance(p, axis, terms)
+        if "thrust_dV" in nuisance:
             not_offered[axis] += [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources),
                                    "reason": NO_THRUST_DRIFT} for t in terms if t.key == "dV"]
             terms = [t for t in terms if t.key != "dV"]
+        if axis in cand.LAT and propeller:
+            not_offered[axis] += [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources),
+                                   "reason": PROPELLER_DRIFT} for t in terms if t.key == "dV"]
+            terms = [t for t in terms if t.key != "dV"]
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
-        sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra)
+        sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra, forced=nuisance)
         by_key = {t.key: t for t in terms}
         for t in sel.terms:
             column = by_key[t.name].column if t.name in by_key else extra[t.name]
             shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
         selections[axis] = (sel, by_key)
+        nuisances[axis] = nuisance
     cands += _aero_candidates(selections, delays, p.dt, shares)
+    slopes: dict[str, dict[str, np.ndarray]] = {}
+
+    def slope_of(x: str) -> dict[str, np.ndarray]:
+        # the model's ∂C/∂x along the states (rivals module docstring), computed once per angle
+        if x not in slopes:
+            shifted = dict(states)
+            shifted[x] = np.asarray(states[x], dtype=float) + rivals.SLOPE_STEP_RAD
+            moved = aero_along(aircraft, ic, shifted, surfaces, p.deriv["alpha"] if "alpha" in p.driven else None)
+            slopes[x] = {c: (moved.coefficients[c] - aero.coefficients[c]) / rivals.SLOPE_STEP_RAD
+                         for c in COEFFICIENTS}
+        return slopes[x]
+
+    _withhold_rivals(cands, selections, nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
     _withhold_ambiguous(cands, kin)
     if turbulent:
         _withhold_in_turbulence(cands)
@@ -232,6 +252,80 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
     return float(given) if given is not None else float(model_trim_thrust_lbf)
 
 
+def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:
+    """Columns always in the fit of ``axis`` for what the thrust does outside the model's
+    aerodynamics. Without a thrust channel (thrust held at trim), CX and Cm get the airspeed
+    change: a jet's thrust changes with airspeed at a fixed throttle, in force and, through
+    the thrust line's offset from the c.g. (5.1 in on JSBSim's F-16), in pitching moment; no
+    other term may stand in for it. (With a thrust channel, Eqs. 1 and 4 use it, with the
+    metadata's ``thrust_offset_ft``.)"""
+    if axis not in ("CX", "Cm") or "thrust" in p.raw:
+        return {}
+    return {"thrust_dV": t.column for t in terms if t.key == "dV"}
+
+
+def _kinematic_bias(kin: KinematicResult, channel: str, applied: set[str]) -> tuple[float, float]:
+    """The kinematic estimate of a vane bias and its standard error (0 ± s.e. once the
+    channels were corrected for it); an infinite s.e. when the check had no such bias."""
+    name = f"bias_{channel}"
+    if name not in kin.selection.params:
+        return 0.0, np.inf
+    se = kin.selection.std_errors.get(name, np.inf)
+    return (0.0 if name in applied else kin.selection.params[name]), (se if se > 0 else np.inf)
+
+
+def _withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
+                     p: Prepared, slope_of, kin: KinematicResult, applied: set[str], V0: float) -> None:
+    """Deselect the aerodynamic terms the data cannot tell from a rival (:mod:`rivals`): a
+    collinear candidate of the same axis, or a vane bias the kinematics cannot rule out. A
+    term that survives keeps its strongest collinear rival in ``details['rival']`` for the
+    validation maneuver to judge."""
+    inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
+    for c in cands:
+        if not c.selected or c.channel not in selections:
+            continue
+        sel, by_key = selections[c.channel]
+        key = next((k for k, t in by_key.items() if t.parameter == c.parameter and k in sel.names), None)
+        if key is None:
+            continue
+        z = mismatch[c.channel][inner]
+        columns = {k: t.column[inner] for k, t in by_key.items()}
+        pool = [k for k in columns if k not in sel.names]
+        columns.update({k: col[inner] for k, col in nuisances.get(c.channel, {}).items() if np.ptp(col[inner]) > 0})
+        others = [n for n in sel.names if n != key and n in columns]
+        others += [k for k in nuisances.get(c.channel, {}) if k in columns]
+        rival = rivals.strongest_rival(z, columns, key, others, pool)
+        if rival is not None:
+            rt = by_key[rival.key]
+            c.details["rival"] = {"parameter": rt.parameter, "effect": rt.effect, "axis": c.channel,
+                                  "correlation": rival.correlation, "t_term": rival.t_term,
+                                  "t_rival": rival.t_rival, "coefficient": rival.swapped}
+            if abs(rival.t_term) < cand.T_IN:
+                # the identification maneuver cannot tell them apart: a finding only if the
+                # validation maneuver prefers it (run.validation_check), never without one
+                c.details["rival"]["indistinct"] = (
+                    f"the identification maneuver cannot tell it from {rt.parameter} (columns correlated "
+                    f"{rival.correlation:+.2f}; beside it, t = {rival.t_term:.1f})")
+        for x in rivals.BIAS_SOURCES:
+            if x not in by_key[key].sources:
+                continue
+            b = rivals.bias_rival(z, columns[key], [columns[n] for n in others], slope_of(x)[c.channel][inner], x,
+                                  _kinematic_bias(kin, x, applied))
+            if (b is not None and abs(b.t_term) < cand.T_IN and not b.ruled_out
+                    and is_plausible(f"bias_{x}", b.bias_rad, V0)):
+                c.selected = False
+                c.reason = (f"entered, but not named: a {x} vane bias of {np.degrees(b.bias_rad):.2f} deg would "
+                            f"imitate it through the model's nonlinearity (beside it, t = {b.t_term:.1f}), and the "
+                            f"kinematics cannot rule that bias out ({_bias_text(b)})")
+                break
+
+
+def _bias_text(b: rivals.BiasRival) -> str:
+    if not np.isfinite(b.kinematic_std):
+        return f"they do not test a {b.channel} bias"
+    return f"bias_{b.channel} = {np.degrees(b.kinematic):.2f} ± {np.degrees(b.kinematic_std):.2f} deg"
+
+
 # The |t| a kinematic estimate needs before it corrects the channels the model is evaluated on.
 APPLY_T = 3.0
 
@@ -245,16 +339,22 @@ AMBIGUOUS_T = 2.5
 AMBIGUOUS_KINDS = ("scale", "skew", "vane")
 
 
-NOT_IN_GUSTS = ("not named: in turbulence the aerodynamics see air-relative rates and accelerations the gyros and "
-                "accelerometers do not measure, which a rate, alpha-dot or accelerometer-position term would fit")
+NOT_IN_GUSTS = ("not named: in turbulence the aerodynamics see air-relative rates (the gust's rotational part, "
+                "which no gyro measures) and the mismatch carries them through every alpha-, rate- and "
+                "surface-correlated column; equation error cannot separate a model term from them (fit the "
+                "recording with the filter-error method, estimate --method fe)")
 
 
 def _withhold_in_turbulence(cands: list[Candidate]) -> None:
-    """In turbulence, deselect the terms the gusts themselves imitate: α̇ terms, rate
-    derivatives (q̂, p̂, r̂) and the accelerometer position from the force mismatch."""
+    """In turbulence, deselect every term fitted to the coefficient mismatch (aerodynamic
+    terms, control delays, the accelerometer position from the force mismatch): the gust's
+    rotational components are unmeasured regressors, correlated with α, α̇ and the rates
+    (a Dryden pitch gust follows the derivative of the vertical gust), so the equation-error
+    fit is biased there. The outside sweep's turbulent nulls named C_Z,α, C_Z,δe, C_m,α and a
+    moment-reference shift at |t| 5-10 before this rule."""
     for c in cands:
-        rate = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
-        if c.selected and (c.effect == "unsteady_alphadot" or rate or c.parameter == "x_accelerometer"):
+        if c.selected and (c.test.startswith("stepwise") or c.test.startswith("delay scan")
+                           or c.parameter == "x_accelerometer"):
             c.selected = False
             c.reason = NOT_IN_GUSTS
 
@@ -348,8 +448,10 @@ def _t_of(kin: KinematicResult, name: str) -> float:
 
 IMPLAUSIBLE = ("not applied: the kinematic fit asks for a sensor error larger than any instrument plausibly has "
                "(kinematics.PLAUSIBLE), so the channels disagree for another reason")
-NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX cannot be told from the "
-                   "thrust's own change with airspeed")
+PROPELLER_DRIFT = ("the propeller's torque, P-factor and slipstream change with airspeed at a fixed throttle, "
+                   "outside the model's aerodynamic coefficients: a lateral drift term would fit them")
+NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX or Cm cannot be told from the "
+                   "thrust's own change with airspeed (its force, and its moment about the c.g.)")
 GUST_RATIO = 4.0     # the integrated kinematic residual over what sensor noise alone gives
 GUST_MIN_FPS = 3.0   # and at least light turbulence's RMS gust
 NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"

@@ -262,12 +262,15 @@ def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: di
 
 
 def axis_selection(p: Prepared, axis: str, mismatch: np.ndarray, terms: list[Term],
-                   extra: dict[str, np.ndarray] | None = None) -> ColoredSelection:
+                   extra: dict[str, np.ndarray] | None = None,
+                   forced: dict[str, np.ndarray] | None = None) -> ColoredSelection:
     """Forward selection of ``terms`` (plus ``extra`` columns, e.g. a delay) on the interior
-    of one axis's mismatch."""
+    of one axis's mismatch; ``forced`` nuisance columns are in every fit."""
     k = max(1, int(round(1.0 / p.dt)))
     inner = slice(k, p.n - k)
     cands = {t.key: t.column[inner] for t in terms}
     for key, col in (extra or {}).items():
         cands[key] = col[inner]
-    return colored_forward_selection(mismatch[inner], cands, t_in=T_IN, min_gain=MIN_GAIN, max_terms=3)
+    nuisance = {key: col[inner] for key, col in (forced or {}).items() if np.ptp(col[inner]) > 0}
+    return colored_forward_selection(mismatch[inner], cands, forced=nuisance, t_in=T_IN, min_gain=MIN_GAIN,
+                                     max_terms=3)

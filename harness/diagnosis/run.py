@@ -182,8 +182,59 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     after_rms = {c: _rms(after[c][inner]) for c in axes}
     ratio = sum(after_rms.values()) / max(sum(before_rms.values()), 1e-300)
     status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
-    return {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms,
-            "change": ratio - 1.0}
+    out = {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms, "change": ratio - 1.0}
+    rival = _rival_check(av, f, axes, {c: after[c][inner] for c in axes})
+    if rival is not None:
+        out["rival"] = rival
+        if status == "confirmed" and rival["fits_as_well"]:
+            out["status"] = "ambiguous"
+            out["reason"] = (f"the validation maneuver is fitted about as well by {rival['parameter']} (its rival in "
+                             f"the identification fit: columns correlated {rival['correlation']:+.2f}; RMS "
+                             f"{sum(rival['rms_after'].values()):.3g} against {sum(after_rms.values()):.3g}"
+                             + (f", a difference under {100 * rival['margin']:.0f} %, two standard errors of an RMS "
+                                f"of this record" if rival["margin"] else "") + ")")
+        elif rival["indistinct"]:
+            out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
+    return out
+
+
+def _undecided(f: Candidate) -> dict | None:
+    """Without a validation maneuver: a finding the identification maneuver cannot tell from
+    its rival is 'ambiguous' (not a finding); the others are not checked (None)."""
+    why = (f.details.get("rival") or {}).get("indistinct")
+    return {"status": "ambiguous", "reason": f"{why}; no validation maneuver to decide"} if why else None
+
+
+def rms_margin(residual: np.ndarray, z: float = 2.0) -> float:
+    """``z`` relative standard errors of an RMS estimated from a colored record: 1/√(2 n_eff),
+    with n_eff = N (1 − ρ₁)/(1 + ρ₁) from the lag-one autocorrelation ρ₁ (Bartlett's
+    first-order approximation for an AR(1) record)."""
+    r = residual - residual.mean()
+    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(float(np.dot(r, r)), 1e-300), -0.99, 0.99))
+    n_eff = max(r.size * (1.0 - rho) / (1.0 + rho), 2.0)
+    return z / np.sqrt(2.0 * n_eff)
+
+
+def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, np.ndarray]) -> dict | None:
+    """The finding's strongest collinear rival (``details['rival']``, :mod:`rivals`), sized
+    as fitted in its place on the identification maneuver, predicting the same validation
+    axes: ``fits_as_well`` when its RMS there is no larger than the finding's. When the
+    identification maneuver could not tell the two apart (``indistinct``), the rival must do
+    worse by more than :func:`rms_margin` (two standard errors of the finding's RMS): a
+    preference within the validation record's own sampling error is then no preference."""
+    r = f.details.get("rival")
+    if not r:
+        return None
+    twin = Candidate(r["effect"], f.axis, r["axis"], r["parameter"], 0.0, 0.0, r["t_rival"], 0.0, "", f.test,
+                     details={"change": r["coefficient"]})
+    rival_after, _ = _after_mismatch(av, [twin])
+    inner = _inner(av.prepared)
+    rival_rms = {c: _rms(rival_after[c][inner]) for c in axes}
+    own = sum(_rms(after[c]) for c in axes)
+    # the margin only where the identification maneuver could not tell the two apart
+    margin = max(rms_margin(after[c]) for c in axes) if r.get("indistinct") else 0.0
+    return {"parameter": r["parameter"], "correlation": r["correlation"], "rms_after": rival_rms, "margin": margin,
+            "fits_as_well": sum(rival_rms.values()) <= own * (1.0 + margin), "indistinct": r.get("indistinct", "")}
 
 
 # The |t| the same sensor parameter must reach, with the same sign, on the validation
@@ -637,10 +688,12 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         pv = prepare(read_recording(validation), "validation")
         av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.altitude))
         checks = {id(f): validation_check(av, f) for f in findings}
-        # a finding is kept only when the validation maneuver confirms it (or cannot test it:
-        # a gust level, a spectral peak); the others are reported apart, not as findings
-        unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"] != "confirmed"]
-        findings = [f for f in findings if f not in unconfirmed]
+    else:
+        checks = {id(f): _undecided(f) for f in findings}
+    # a finding is kept only when the validation maneuver confirms it (or cannot test it:
+    # a gust level, a spectral peak); the others are reported apart, not as findings
+    unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"] != "confirmed"]
+    findings = [f for f in findings if f not in unconfirmed]
     modelled = list(findings)
     added = tuple(e for e in (_effect_of(f) for f in modelled) if e is not None)
     timing = {"analysis": time.perf_counter() - t0}
