@@ -142,6 +142,23 @@ def is_turboprop(model: str) -> bool:
     return False
 
 
+def has_propeller(model: str) -> bool:
+    """Whether any of the model's thrusters is a JSBSim ``<propeller>`` (its torque, P-factor
+    and slipstream then change with airspeed at a fixed throttle, outside the aerodynamics)."""
+    source = model_xml(model)
+    prop = ET.parse(source).getroot().find("propulsion")
+    places = (engine_root(source) / "engine", source.parent, source.parent / "Engines")
+    for el in (prop.iter("thruster") if prop is not None else []):
+        name = el.get("file", "")
+        files = (name,) if name.endswith(".xml") else (name, f"{name}.xml")
+        for path in (d / f for d in places for f in files):
+            if path.is_file():
+                if ET.parse(path).getroot().tag == "propeller":
+                    return True
+                break
+    return False
+
+
 def missing_files(model: str) -> list[str]:
     """The engine, thruster and system files an aircraft XML given by path names but JSBSim
     would not find (engines in ``<root>/engine``, beside the XML or in its ``Engines/``;
