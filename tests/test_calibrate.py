@@ -179,3 +179,24 @@ def test_auto_takes_the_terms_the_diagnosis_added(recordings, tmp_path):
     path.write_text(json.dumps({"model": {"terms": findings["model"]["terms"][2:]}}))
     with pytest.raises(CalibrationError, match="no aerodynamic or delay term"):
         calibrate("f16", recordings["identification"], f"auto={path}", workers=1)
+
+
+def test_mass_and_reference_point_adjustments_reach_jsbsim(tmp_path):
+    """iyy:scale multiplies the inertia JSBSim computes from the empty weight's (the fuel adds
+    its own); cg_x and aero_rp_x move the c.g. and the aerodynamic reference point by inches."""
+    base = base_aircraft("f16")
+    read = {}
+    for tag, values in (("nominal", (1.0, 0.0, 0.0)), ("changed", (2.0, 3.0, -4.0))):
+        adj = tuple(parse_adjustment(n) for n in ("iyy:scale", "cg_x:increment", "aero_rp_x:increment"))
+        tree = adjusted_tree(base.tree(), adj, values, refs={}, surfaces=base.aircraft.surfaces)
+        write_root(tmp_path / tag, "f16m", tree, Path(base.source))
+        fdm = new_fdm(tmp_path / tag, "f16m", 1 / 120)
+        fdm["ic/h-sl-ft"], fdm["ic/vt-fps"] = 10_000.0, 420.0
+        fdm.run_ic()
+        read[tag] = {p: fdm[p] for p in ("inertia/iyy-slugs_ft2", "inertia/cg-x-in", "metrics/aero-rp-x-in",
+                                          "inertia/empty-weight-lbs", "inertia/weight-lbs")}
+    n, c = read["nominal"], read["changed"]
+    assert c["metrics/aero-rp-x-in"] - n["metrics/aero-rp-x-in"] == pytest.approx(-4.0)
+    share = n["inertia/empty-weight-lbs"] / n["inertia/weight-lbs"]
+    assert c["inertia/cg-x-in"] - n["inertia/cg-x-in"] == pytest.approx(3.0 * share, rel=1e-6)
+    assert c["inertia/iyy-slugs_ft2"] > 1.5 * n["inertia/iyy-slugs_ft2"]
