@@ -46,8 +46,9 @@ def test_filter_error_predictor_is_stable_by_construction():
     """Seed 311 of the process-noise test used to stop "did not converge" when the gain was
     estimated directly (the likelihood kept falling as the predictor's slowest mode crossed the
     unit circle). With the gain from the noise covariances (the Riccati equation's stabilising
-    solution) the predictor is stable whatever the estimates, and the fit converges inside."""
-    fit = FilterError().fit(turbulent_recording(311))
+    solution) the predictor is stable whatever the estimates, and the fit converges inside
+    (white process noise on α and q, the structure of these data: ``gust=None``)."""
+    fit = FilterError(gust=None).fit(turbulent_recording(311))
     assert fit.info["converged"], fit.warnings
     assert not any("did not converge" in w for w in fit.warnings)
     assert fit.info["spectral_radius"] < 0.95
@@ -60,12 +61,13 @@ CASE = (BUILTIN_DIR / "turbulence.toml").read_text()
 def test_turbulence_campaign_filter_error_covers_where_output_error_does_not(tmp_path):
     """The `turbulence` campaign cut to 50 realizations and oe, fe. Output error's ±2σ
     Cramér-Rao intervals are over-confident: every derivative's exact (Clopper-Pearson) 95 %
-    interval for the coverage lies below 0.90. Filter error's CZ derivatives cover at the
-    nominal rate (the interval contains 0.95); its Cm derivatives (noise covariances estimated,
-    gain from the Riccati equation) still fall short on Cm_α: 0.82 [0.73, 0.89] over 100
-    realizations, Cm_q̂ and Cm_δe 0.90 [0.82, 0.95] (README), so for all six only ≥ 0.70 is
-    asserted (at n = 50 the binomial standard deviation is ≤ 0.065), and the standard errors
-    at least 0.6 of the scatter (0.67 measured on Cm_α, 0.59 with the gain estimated directly)."""
+    interval for the coverage lies below 0.90. Filter error's (the short period's defaults: a
+    gust state through α, the stabilator's measurement noise) cover at the nominal rate: each
+    derivative's interval contains 0.95 and its coverage is ≥ 0.85 (0.95 less 3 binomial
+    standard deviations at n = 50; 0.88–0.96 measured, 0.92–0.97 over 100 realizations,
+    README), and the standard errors are at least 0.75 of the scatter (the ratio's sampling
+    standard deviation is ≈ 0.1 at n = 50; 0.85–1.09 measured; 0.67 on Cm_α with white process
+    noise on α and q, the previous default)."""
     n = 50
     text = CASE.replace("realizations = 100", f"realizations = {n}").replace(
         'method = ["oe", "fe", "ee-freq"]', 'method = ["oe", "fe"]')
@@ -80,10 +82,9 @@ def test_turbulence_campaign_filter_error_covers_where_output_error_does_not(tmp
         oe, fe = s.loc[("oe", p)], s.loc[("fe", p)]
         assert oe["n"] == fe["n"] == n and fe["failures"] == 0
         assert oe["coverage_hi"] < 0.90, (p, oe["coverage"])
-        assert fe["coverage"] >= 0.70, (p, fe["coverage"])
+        assert fe["coverage"] >= 0.85, (p, fe["coverage"])
+        assert fe["coverage_lo"] <= 0.95 <= fe["coverage_hi"], (p, fe["coverage"])
         assert fe["coverage"] > oe["coverage"] + 0.3, p
         assert fe["se_ratio"] > 2 * oe["se_ratio"], p
-        assert fe["se_ratio"] > 0.6, (p, fe["se_ratio"])
-        if p.startswith("CZ"):
-            assert fe["coverage_lo"] <= 0.95 <= fe["coverage_hi"], (p, fe["coverage"])
+        assert fe["se_ratio"] > 0.75, (p, fe["se_ratio"])
     assert math.isfinite(s.loc[("fe", "Cm_alpha"), "bias_z"])
