@@ -484,11 +484,11 @@ class FilterError:
             return out
 
         def uninformed(free):
-            """Parameters the information matrix says nothing about: a gust's τ with the gust at
-            its floor (log-parameterised σ: zero information there)."""
+            """Parameters the information matrix says nothing about: a gust's σ and τ with the
+            gust at its floor (log-parameterised: no information there)."""
             out = np.zeros(p, bool)
             if gust is not None and not free[lay.sigma]:
-                out[lay.tau] = True
+                out[lay.sigma] = out[lay.tau] = True
             return out
 
         try:
@@ -556,6 +556,10 @@ class FilterError:
         at_bound = [k for k, f in zip(names, free) if not f]
         if not converged:
             warnings.append(f"filter error did not converge in {it} iterations")
+        if gust is not None and not keep[lay.sigma]:
+            warnings.append(f"no gust in these data: its standard deviation is at its floor (1e-4 of {gust}'s "
+                            "output-error residual), so ln_sigma_gust and ln_tau_gust have no standard error "
+                            "(gust=None fits without the gust state)")
         r2 = {o: 1 - float(np.sum(nu[:, i] ** 2) / np.sum((z[:, i] - z[:, i].mean()) ** 2))
               for i, o in enumerate(spec.outputs)}
         K = filter_of(theta)[7]

@@ -56,6 +56,9 @@ def test_without_process_noise_filter_error_is_output_error():
     assert white.names[:11] == o.names and white.names[11:] == ("Q_alpha", "Q_q", "R_alpha", "R_q", "R_az")
     assert gust.names[11:] == ("ln_sigma_gust", "ln_tau_gust", "R_alpha", "R_q", "R_az")
     assert gust.info["input_noise"] == {"de": 0.0}  # a noise-free stabilator is taken as exact
+    # still air: the gust at its floor, said so, without a made-up standard error
+    assert "ln_sigma_gust" in gust.info["at_bound"] and any(w.startswith("no gust") for w in gust.warnings)
+    assert np.isnan(gust.std_error("ln_sigma_gust")) and np.isnan(gust.std_error("ln_tau_gust"))
     for f in (white, gust):
         for name in SHORT_PERIOD:
             assert abs(f.param(name) - o.param(name)) < 2 * f.std_error(name), name  # both unbiased here
