@@ -12,6 +12,7 @@ import pandas as pd
 
 from maneuvers.recording import Recording
 from models.constants import G0_FPS2
+from models.axes import wind_axis_coefficients
 
 
 def accelerometer_at_cg(ax_g, ay_g, az_g, p, q, r, pdot, qdot, rdot, r_ft) -> tuple[np.ndarray, ...]:
@@ -35,12 +36,6 @@ def force_coefficients(ax_g, ay_g, az_g, thrust_lbf, qbar_psf, mass_slug, S_ft2)
     qS = np.asarray(qbar_psf) * S_ft2
     m = np.asarray(mass_slug) * G0_FPS2
     return {"CX": (m * ax_g - thrust_lbf) / qS, "CY": m * ay_g / qS, "CZ": m * az_g / qS}
-
-
-def wind_axis_coefficients(CX, CZ, alpha) -> dict[str, np.ndarray]:
-    """Seed Eq. 2: CD = −CX cos α − CZ sin α, CL = −CZ cos α + CX sin α."""
-    ca, sa = np.cos(alpha), np.sin(alpha)
-    return {"CD": -CX * ca - CZ * sa, "CL": -CZ * ca + CX * sa}
 
 
 def moment_coefficients(p, q, r, pdot, qdot, rdot, qbar_psf, S_ft2, b_ft, cbar_ft,

@@ -46,7 +46,7 @@ import numpy.typing as npt
 from scipy import fft as sp_fft
 from scipy import linalg
 
-__all__ = ["residual_autocorrelation", "colored_residual_covariance"]
+__all__ = ["residual_autocorrelation", "colored_middle", "colored_residual_covariance"]
 
 # Up to this many lags the direct O(N r) sums are used; beyond it, FFTs.
 # (Measured crossover on N = 1e5, 4 columns: a few tens of lags.)
@@ -200,6 +200,23 @@ def _toeplitz_quadratic(q: np.ndarray, v: np.ndarray, r: int, r_vals: np.ndarray
     return middle
 
 
+def colored_middle(X: npt.ArrayLike, residuals: npt.ArrayLike, max_lag: int | None = None,
+                   method: Literal["auto", "direct", "fft"] = "auto") -> np.ndarray:
+    """The middle matrix of seed Eq. 40, ``X^T T X`` with ``T[i, j] = R(|i - j|)`` the residual
+    autocorrelation of Eq. 39 (1/N normalisation), zero beyond ``max_lag`` (all lags when None;
+    at most N - 1), symmetrised; ``T`` is never formed (see :func:`_toeplitz_quadratic`)."""
+    x = np.asarray(X, dtype=float)
+    v = np.asarray(residuals, dtype=float)
+    n = x.shape[0]
+    r = min(_resolve_max_lag(max_lag, n), n - 1)
+    if method == "auto":
+        method = "direct" if r <= _DIRECT_MAX_LAG else "fft"
+    # with all lags the FFT route takes the kernel's spectrum straight from the residuals'
+    r_vals = None if (method == "fft" and r == n - 1) else residual_autocorrelation(v, r)
+    middle = _toeplitz_quadratic(x, v, r, r_vals, method)
+    return 0.5 * (middle + middle.T)
+
+
 def colored_residual_covariance(
     X: npt.ArrayLike,
     residuals: npt.ArrayLike,
@@ -291,10 +308,6 @@ def colored_residual_covariance(
     if method not in ("auto", "direct", "fft"):
         raise ValueError("method must be 'auto', 'direct' or 'fft'")
     r = min(_resolve_max_lag(max_lag, n), n - 1)
-    if method == "auto":
-        method = "direct" if r <= _DIRECT_MAX_LAG else "fft"
-    # with all lags the FFT route takes the kernel's spectrum straight from the residuals'
-    r_vals = None if (method == "fft" and r == n - 1) else residual_autocorrelation(v, r)
 
     if factor is None:
         q, rr = linalg.qr(xm, mode="economic", overwrite_a=True, check_finite=False)
@@ -307,9 +320,8 @@ def colored_residual_covariance(
     if diag.min() <= np.finfo(float).eps * max(n, n_p) * diag.max():
         raise np.linalg.LinAlgError("X is rank deficient; X^T X is singular")
 
-    middle = _toeplitz_quadratic(q, v, r, r_vals, method)
+    middle = colored_middle(q, v, r, method)
     del q
-    middle = 0.5 * (middle + middle.T)
     a = linalg.solve_triangular(rr, middle)  # R^{-1} M
     cov = linalg.solve_triangular(rr, a.T).T  # R^{-1} M R^{-T}
     return 0.5 * (cov + cov.T)

@@ -53,10 +53,7 @@ def _as_data(source: Recording | RegressionData, equation: Equation | None, opti
 
 
 def _warnings(names: tuple[str, ...], fit_coll, notes: tuple[str, ...]) -> tuple[str, ...]:
-    w = list(notes)
-    for a, b, r in fit_coll.flagged:
-        w.append(f"regressors {a} and {b} are nearly collinear (|r| = {r:.3f} > 0.9, seed Eq. 50)")
-    return tuple(w)
+    return tuple(notes) + fit_coll.warnings()
 
 
 def colored_to_conventional_se(cov_colored: np.ndarray, cov_conventional: np.ndarray) -> np.ndarray:

@@ -179,8 +179,7 @@ class FrequencyOutputError:
         cov = _inverse(M, _check_information(M, names))
         is_bias = np.array([k.startswith("dx_") for k in names])
         coll = collinearity(np.concatenate([J.real, J.imag], axis=1).reshape(len(J), -1).T, names, cov, is_bias)
-        warnings = [f"parameters {a} and {b} are highly correlated (|r| = {r:.3f} > 0.9, seed Eq. 50)"
-                    for a, b, r in coll.flagged]
+        warnings = list(coll.warnings(parameters=True))
         if not converged:
             warnings.append(f"frequency-domain output error did not converge in {it} iterations")
         r2 = 1 - float(np.sum(np.abs(v) ** 2) / np.sum(np.abs(Z - Z.mean(axis=0)) ** 2))

@@ -1,15 +1,21 @@
-"""The estimation methods by name, so a method is swapped in one line (or one option)."""
+"""The estimation methods by name, so a method is swapped in one line (or one option).
+
+Every method of the registry (:mod:`estimators.registry`: single-maneuver, multiple-maneuver or
+stepwise, with its declared capabilities) is built by :func:`make_estimator` and fitted by its one
+``fit``.
+"""
 from __future__ import annotations
 
 from typing import Protocol
 
 from estimators.equation_error import SIDPAC_FREQUENCY_OPTIONS, EquationErrorFrequency, EquationErrorTime
+from estimators.registry import COMBINED_METHODS, METHODS, REGISTRY, MethodInfo, method_info
 from estimators.regressors import DataOptions, Equation
 from estimators.result import ModelFit
 from models.errors import OptionError
 
-METHODS = ("ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe")
-__all__ = ["METHODS", "SIDPAC_FREQUENCY_OPTIONS", "Estimator", "make_estimator", "parse_frequencies"]
+__all__ = ["METHODS", "COMBINED_METHODS", "REGISTRY", "MethodInfo", "method_info", "SIDPAC_FREQUENCY_OPTIONS",
+           "Estimator", "make_estimator", "parse_frequencies"]
 
 
 class Estimator(Protocol):
@@ -23,8 +29,8 @@ class Estimator(Protocol):
 
 def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None = None,
                    frequencies_hz: tuple[float, ...] | str | None = None, detrend: str = "lstsq",
-                   data: DataOptions = DataOptions()) -> Estimator:
-    """The estimator called ``name`` (one of :data:`METHODS`).
+                   data: DataOptions = DataOptions(), model: str | None = None) -> Estimator:
+    """The estimator called ``name`` (one of :data:`REGISTRY`).
 
     ``errors`` applies to the time-domain equation-error methods; ``None`` is the method's
     default: colored residuals (Eq. 40) for ``ee-smooth``, conventional (Eq. 15) for
@@ -33,28 +39,35 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
     Cramér-Rao bound. ``frequencies_hz`` and ``detrend`` shape ``ee-freq``: by default the
     seed's rule (2/T to 1.2 Hz by 0.04 Hz) and a least-squares line;
     ``**SIDPAC_FREQUENCY_OPTIONS`` (``frequencies_hz='sidpac'``, ``detrend='endpoints'``)
-    gives SIDPAC's Eq. 18 band and end-point line.
+    gives SIDPAC's Eq. 18 band and end-point line. ``model`` names the output-error family's
+    built-in model (None: chosen from the equation fitted).
     """
+    info = method_info(name)
+    if errors == "colored" and not info.supports("colored"):
+        raise OptionError(f"--errors colored applies to the time-domain equation-error methods, not {name}: "
+                          "the frequency-domain residuals are treated as white over the band (seed §III.E) "
+                          "and output error reports the Cramér-Rao bound")
     if name == "ee-time":
         return EquationErrorTime(errors=errors, max_lag=max_lag, data=data)
     if name == "ee-smooth":
         return EquationErrorTime(errors=errors, max_lag=max_lag, smooth_regressors=True, data=data)
-    if name in ("ee-freq", "oe", "oe-freq", "fe") and errors == "colored":
-        raise OptionError(f"--errors colored applies to the time-domain equation-error methods, not {name}: "
-                         "the frequency-domain residuals are treated as white over the band (seed §III.E) "
-                         "and output error reports the Cramér-Rao bound")
     if name == "ee-freq":
         return EquationErrorFrequency(frequencies_hz=frequencies_hz, detrend=detrend, data=data)
     if name == "oe":
         from estimators.output_error import OutputError
-        return OutputError(data=data)
+        return OutputError(model=model, data=data)
     if name == "oe-freq":
         from estimators.frequency_output_error import FrequencyOutputError
-        return FrequencyOutputError(data=data)
+        return FrequencyOutputError(model=model, data=data)
     if name == "fe":
         from estimators.filter_error import FilterError
-        return FilterError(data=data)
-    raise OptionError(f"unknown method {name!r}; choose one of {METHODS}")
+        return FilterError(model=model, data=data)
+    if name == "stepwise":
+        from estimators.stepwise import Stepwise
+        return Stepwise(data=data)
+    from estimators.multiple import Combined
+    return Combined(method=name, errors=errors or "conventional", max_lag=max_lag,
+                    frequencies_hz=frequencies_hz, detrend=detrend)
 
 
 def parse_frequencies(text: str) -> tuple[float, ...] | str:
@@ -68,7 +81,7 @@ def parse_frequencies(text: str) -> tuple[float, ...] | str:
             f0, df, f1 = (float(x) for x in text.split(":"))
         except ValueError:
             raise OptionError(f"--frequencies must be auto, eq18, sidpac, F0:DF:F1 or a comma list, "
-                             f"not {text!r}") from None
+                              f"not {text!r}") from None
         if not (0 < f0 < f1 and df > 0):
             raise OptionError(f"--frequencies {text!r}: need 0 < F0 < F1 and DF > 0")
         n = int(round((f1 - f0) / df)) + 1

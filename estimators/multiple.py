@@ -24,20 +24,43 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 import scipy.linalg
-from scipy import signal
 
-from estimators.colored import residual_autocorrelation
+from estimators.colored import colored_middle
 from estimators.equation_error import ERRORS, EquationErrorFrequency, fit_frequency_domain, frequency_band
 from estimators.least_squares import SingularRegressorsError, check_rank, least_squares, r_squared
 from estimators.regressors import Equation, RegressionData
 from estimators.result import ModelFit, collinearity
 
 __all__ = [
-    "concatenate", "colored_middle", "fit_concatenated", "fit_a_priori", "fit_sequential",
+    "Combined", "concatenate", "colored_middle", "fit_concatenated", "fit_a_priori", "fit_sequential",
     "fit_frequency_combined",
 ]
 
-_DIRECT_MAX_LAG = 32  # up to this many lags the Toeplitz product uses shifted sums, else FFTs
+
+@dataclass(frozen=True)
+class Combined:
+    """Several maneuvers of one equation fitted together (seed §III.F), behind the estimators'
+    one ``fit``: ``method`` is ``ee-concat`` (concatenation, Eq. 42, with ``errors``),
+    ``ee-sequential`` / ``ee-sequential-unequal`` (a-priori combination with equal or unequal
+    variances, Eqs. 45-49) or ``ee-freq-combined`` (common frequencies)."""
+
+    method: str = "ee-concat"
+    errors: str = "conventional"
+    max_lag: int | None = None
+    frequencies_hz: npt.ArrayLike | str | None = None
+    detrend: str = "lstsq"
+
+    def fit(self, source: Sequence[RegressionData], equation: Equation | None = None) -> ModelFit:
+        datasets = list(source)
+        if equation is not None and any(d.equation != equation for d in datasets):
+            raise ValueError("fit() got RegressionData and a different equation; pass one or the other")
+        if self.method == "ee-concat":
+            return fit_concatenated(datasets, errors=self.errors, max_lag=self.max_lag)
+        if self.method in ("ee-sequential", "ee-sequential-unequal"):
+            return fit_sequential(datasets, equal_variances=self.method == "ee-sequential")
+        if self.method == "ee-freq-combined":
+            return fit_frequency_combined(datasets, frequencies_hz=self.frequencies_hz, detrend=self.detrend)
+        raise ValueError(f"no multiple-maneuver method {self.method!r}")
 
 
 # -- checks and bookkeeping --------------------------------------------------------------------
@@ -62,8 +85,7 @@ def _slices(datasets: Sequence[RegressionData]) -> tuple[slice, ...]:
 
 
 def _warnings(coll, notes: Sequence[str] = ()) -> tuple[str, ...]:
-    return tuple(notes) + tuple(f"regressors {a} and {b} are nearly collinear (|r| = {r:.3f} > 0.9, "
-                                f"seed Eq. 50)" for a, b, r in coll.flagged)
+    return tuple(notes) + coll.warnings()
 
 
 def _unique_notes(datasets: Sequence[RegressionData]) -> tuple[str, ...]:
@@ -113,33 +135,6 @@ def concatenate(datasets: Sequence[RegressionData]) -> RegressionData:
     return RegressionData(ds[0].equation, np.concatenate([d.z for d in ds]),
                           np.vstack([d.X for d in ds]), np.concatenate(t), dt,
                           _unique_notes(ds) + (note,))
-
-
-def _toeplitz_product(r_vals: np.ndarray, A: np.ndarray) -> np.ndarray:
-    """``T @ A`` with ``T[i, j] = r_vals[|i - j|]`` (zero beyond the last lag), T never formed."""
-    n, r = A.shape[0], min(len(r_vals) - 1, A.shape[0] - 1)
-    if r <= _DIRECT_MAX_LAG:
-        out = r_vals[0] * A
-        for k in range(1, r + 1):
-            out[:-k] += r_vals[k] * A[k:]
-            out[k:] += r_vals[k] * A[:-k]
-        return out
-    kernel = np.concatenate([r_vals[r:0:-1], r_vals[:r + 1]])
-    return signal.fftconvolve(A, kernel[:, None], mode="full", axes=0)[r:r + n]
-
-
-def colored_middle(A: np.ndarray, residuals: np.ndarray, max_lag: int | None = None) -> np.ndarray:
-    """The middle matrix of seed Eq. 40 for one maneuver.
-
-    ``M = Σ_i Σ_j x_i R̂(i − j) x_jᵀ`` with R̂ the residual autocorrelation of Eq. 39 (1/N
-    normalisation, N the maneuver's length), truncated at ``max_lag`` (all lags when None).
-    """
-    A = np.asarray(A, dtype=float)
-    n = A.shape[0]
-    r = n - 1 if max_lag is None else min(int(max_lag), n - 1)
-    r_vals = residual_autocorrelation(np.asarray(residuals, dtype=float), r)
-    middle = A.T @ _toeplitz_product(r_vals, A)
-    return 0.5 * (middle + middle.T)
 
 
 def fit_concatenated(datasets: Sequence[RegressionData], errors: str = "conventional", *,

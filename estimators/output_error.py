@@ -416,8 +416,7 @@ class OutputError:
         is_bias = np.array([n.startswith("bias") for n in spec.names])
         coll = collinearity((S @ _whitener(R)).reshape(len(S), -1).T, spec.names, cov, is_bias)
         r2 = {o: r_squared(z[:, i], v[:, i]) for i, o in enumerate(spec.outputs)}
-        warnings = [f"parameters {a} and {b} are highly correlated (|r| = {r:.3f} > 0.9, seed Eq. 50)"
-                    for a, b, r in coll.flagged]
+        warnings = list(coll.warnings(parameters=True))
         if not converged:
             warnings.append(f"output error did not converge in {iterations} iterations")
         A, B, C, D = problem.system.matrices(theta)

@@ -247,8 +247,7 @@ def fit_model(model, datasets: Sequence[ManeuverData], *, start: Mapping[str, fl
     is_bias = np.array([k.startswith(("bias", "x0_")) for k in names])
     coll = collinearity((S @ _whitener(R)).reshape(len(S), -1).T, names, cov, is_bias)
     r2 = {o: r_squared(z[:, i], v[:, i]) for i, o in enumerate(model.outputs)}
-    warnings = [f"parameters {a} and {b} are highly correlated (|r| = {r:.3f} > 0.9, seed Eq. 50)"
-                for a, b, r in coll.flagged]
+    warnings = list(coll.warnings(parameters=True))
     at_bound = [k for k, t, lo, hi in zip(names, theta, lower, upper) if t <= lo or t >= hi]
     if at_bound:
         warnings.append(f"parameters at a bound: {', '.join(at_bound)} (their Cramér-Rao bounds assume "

@@ -26,6 +26,14 @@ class Collinearity:
     condition_number: float
     flagged: tuple[tuple[str, str, float], ...]
 
+    def warnings(self, *, parameters: bool = False) -> tuple[str, ...]:
+        """One line per pair above :data:`COLLINEARITY_LIMIT`: regressors nearly collinear (an
+        equation-error fit), or parameters highly correlated (``parameters``: output error)."""
+        what = "parameters {} and {} are highly correlated" if parameters else \
+            "regressors {} and {} are nearly collinear"
+        return tuple(what.format(a, b) + f" (|r| = {r:.3f} > {COLLINEARITY_LIMIT:g}, seed Eq. 50)"
+                     for a, b, r in self.flagged)
+
 
 def parameter_correlation(cov: np.ndarray) -> np.ndarray:
     """Seed Eq. 50: r_jk = C_jk / sqrt(C_jj C_kk)."""

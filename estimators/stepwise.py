@@ -30,17 +30,17 @@ is the final arbiter of collinearity.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
 import scipy.linalg
 
 from estimators.least_squares import LeastSquares, SingularRegressorsError, least_squares, r_squared
-from estimators.regressors import RegressionData
+from estimators.regressors import DataOptions, RegressionData
 from estimators.result import ModelFit, collinearity
 
-__all__ = ["RULES", "StepwiseSpec", "StepwiseStep", "CandidateF", "StepwiseResult", "stepwise_regression"]
+__all__ = ["RULES", "StepwiseSpec", "StepwiseStep", "CandidateF", "StepwiseResult", "Stepwise", "stepwise_regression"]
 
 RULES = ("F", "F+PSE")
 _SINGULAR = 1e-10  # a candidate whose part orthogonal to the model is this small (relative) is dependent
@@ -473,8 +473,7 @@ def stepwise_regression(z: npt.ArrayLike | None, candidates: Mapping[str, npt.Ar
 
     A, names = prob.design(model.terms), prob.labels(model.terms)
     coll = collinearity(A, names, model.fit.cov) if len(names) else None
-    warnings = () if coll is None else tuple(
-        f"regressors {a} and {b} are nearly collinear (|r| = {r:.3f} > 0.9, seed Eq. 50)" for a, b, r in coll.flagged)
+    warnings = () if coll is None else coll.warnings()
     info = {"rule": spec.rule, "f_in": spec.f_in, "f_out": spec.f_out, "stop_reason": stop_reason,
             "steps": len(history)}
     if dt is None and isinstance(candidates, RegressionData):
@@ -487,3 +486,21 @@ def stepwise_regression(z: npt.ArrayLike | None, candidates: Mapping[str, npt.Ar
                      warnings=warnings, info=info)
     return StepwiseResult(selected=tuple(prob.names[j] for j in model.terms), history=tuple(history), fit=final,
                           candidates=_candidate_table(prob, model, forced_idx), spec=spec, stop_reason=stop_reason)
+
+
+@dataclass(frozen=True)
+class Stepwise:
+    """Stepwise regression behind the estimators' one ``fit`` (registry name ``stepwise``): the
+    equation's regressors are the candidates, and the fit is the final model's (its names a
+    subset of them). The full history is :func:`stepwise_regression`'s."""
+
+    data: DataOptions = field(default_factory=DataOptions)
+    f_in: float = 4.0
+    f_out: float = 4.0
+    rule: str = "F+PSE"
+    method = "stepwise"
+
+    def fit(self, source, equation=None) -> ModelFit:
+        from estimators.equation_error import _as_data
+        d = _as_data(source, equation, self.data)
+        return stepwise_regression(None, d, f_in=self.f_in, f_out=self.f_out, rule=self.rule).fit

@@ -17,6 +17,7 @@ import tomllib
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from estimators.registry import COMBINED_METHODS, METHODS
 from estimators.regressors import Equation
 from harness.errors import UserError
 from harness.noise import ChannelNoise, NoiseModel
@@ -25,8 +26,6 @@ from models.atmosphere import Turbulence
 
 BUILTIN_DIR = Path(__file__).resolve().parent / "campaigns"
 APPLY_TO = ("both", "regressors", "outputs")
-# Methods of a combined (multiple-maneuver) campaign, seed §III.F.
-COMBINED_METHODS = ("ee-concat", "ee-sequential", "ee-sequential-unequal", "ee-freq-combined")
 
 
 class CampaignError(UserError):
@@ -406,7 +405,6 @@ def load_campaign(path: str | Path) -> Campaign:
             _check_flight_axes(f.aircraft, f.variant, f.condition, f.loop, "grid.", where)
     for f in flights:
         _check_maneuver_kind(f.maneuver, where)
-    from estimators.methods import METHODS
     combine = bool(d.get("combine", False))
     allowed = COMBINED_METHODS if combine else METHODS
     methods = tuple(_list(grid, "method", ["ee-concat" if combine else "ee-time"], where))

@@ -15,6 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from estimators.registry import METHODS
 from harness.flying import AIRCRAFT_HELP, CONDITION_HELP, add_flight_options, add_noise_options
 
 
@@ -126,7 +127,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--model-file", default=None,
                    help="oe: a Python file defining `model` (estimators.dynamic_models.Model), fitted as written "
                         "instead of the built-in linear models; the file is code that runs: use only files you trust")
-    e.add_argument("--method", default="ee-time", choices=["ee-time", "ee-smooth", "ee-freq", "oe", "oe-freq", "fe"],
+    e.add_argument("--method", default="ee-time", choices=METHODS,
                    help="ee-time, ee-smooth (smoothed regressors), ee-freq (frequency domain), oe (output error), "
                         "oe-freq (output error in the frequency domain), fe (filter error)")
     e.add_argument("--errors", default=None, choices=["conventional", "colored"],

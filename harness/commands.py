@@ -114,9 +114,9 @@ def _check_estimate_outputs(args: argparse.Namespace) -> None:
 
 
 def cmd_estimate(args: argparse.Namespace) -> int:
-    from estimators.methods import make_estimator, parse_frequencies
+    from estimators.methods import make_estimator, method_info, parse_frequencies
     from estimators.regressors import DataOptions, Equation
-    from harness.estimate_run import OE_METHODS, equation_time_histories, output_error_time_histories
+    from harness.estimate_run import equation_time_histories, output_error_time_histories
     from harness.recording_io import read_recording
 
     _check_estimate_outputs(args)
@@ -132,12 +132,12 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     if args.dependent is None or args.regressors is None:
         raise OptionError("--dependent and --regressors are required (or --method oe --model-file FILE)")
     rec = read_recording(args.recording)
-    equation = Equation.parse(args.dependent, args.regressors, bias=not args.no_bias and args.method != "ee-freq")
+    equation = Equation.parse(args.dependent, args.regressors, bias=not args.no_bias and method_info(args.method).bias)
     data = DataOptions(angular_acceleration=args.angular_acceleration, reference=args.reference)
     estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
                                detrend=args.detrend, data=data)
     fit = estimator.fit(rec, equation)
-    if args.method in OE_METHODS:  # oe fits its model's terms
+    if method_info(args.method).whole_model:  # output error fits its model's terms
         print(f"{args.recording}: output error, {fit.info['model']} model, outputs {fit.dependent}")
         time, regs, notes = output_error_time_histories(rec, fit)
         names = tuple(regs.columns) if regs is not None else ()

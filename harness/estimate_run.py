@@ -16,7 +16,6 @@ import pandas as pd
 from estimators.result import ModelFit
 
 TRUTH_DEFINITIONS = ("local", "fit")
-OE_METHODS = ("oe", "oe-freq", "fe")
 
 
 @dataclass(frozen=True)

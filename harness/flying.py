@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
+
+from harness.errors import OptionError
 
 INPUT_CHOICES = ("doublet", "2-1-1-2", "2-1-1", "3-2-1-1", "sweep-linear", "sweep-log", "multisine",
                  "three-axis", "lateral")
@@ -48,9 +51,6 @@ def add_noise_options(p: argparse.ArgumentParser) -> None:
 
 def resolve_aircraft(model: str, variant: str = "nominal"):
     """``--aircraft``: a project model by name or a JSBSim aircraft XML by path (as ``diagnose --model``)."""
-    from pathlib import Path
-
-    from harness.errors import OptionError
     from models.aircraft import MODELS, Aircraft, is_xml_model
 
     if model in MODELS:
@@ -102,8 +102,6 @@ def spec_from_args(args: argparse.Namespace):
 
 def fly_default(out: Path) -> Path:
     """Fly the seed's default maneuver, print its truth table, write the recording."""
-    from pathlib import Path
-
     from harness.recording_io import write_recording
     from maneuvers.fly import FlightSpec, fly_maneuver, truth_table
     from models.truth import Derivatives

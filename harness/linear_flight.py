@@ -33,6 +33,7 @@ from estimators.state_space import (discretize, expm_small, lateral_matrices, pr
 from harness.campaign import FlightKey
 from maneuvers.recording import Recording
 from models.constants import G0_FPS2, SURFACES
+from models.axes import wind_axis_coefficients
 
 LATERAL = ("CY", "Cl", "Cn")
 LAT_VARS = ("beta", "phat", "rhat", "da", "dr")
@@ -171,8 +172,7 @@ def linear_flight(key: FlightKey, fly_nominal, turbulence=None, turbulence_seed:
         "az_g": CZ * qS / (m["mass_slug"] * G0_FPS2),
         "truth_CX_1": CX, "truth_CY_1": tc["CY"] + dC["CY"], "truth_CZ_1": CZ,
         "truth_Cl_1": tc["Cl"] + dC["Cl"], "truth_Cm_1": Cm, "truth_Cn_1": tc["Cn"] + dC["Cn"],
-        "truth_CD_1": -CX * np.cos(alpha_abs) - CZ * np.sin(alpha_abs),
-        "truth_CL_1": -CZ * np.cos(alpha_abs) + CX * np.sin(alpha_abs),
+        **{f"truth_{k}_1": v for k, v in wind_axis_coefficients(CX, CZ, alpha_abs).items()},
         "truth_alphadot_rps": alphadot,
     }
     if gust is not None:

@@ -11,6 +11,7 @@ from harness.campaign import Campaign, FlightKey, ManeuverDef, NoiseDef, parse_e
 from harness.runner import CampaignRun, run_campaign
 from harness.store import write_parquet
 from harness.tasks import cached_flight, excited_equations
+from estimators.result import COLLINEARITY_LIMIT
 
 LON = ("Cm = alpha + qhat + de", "CZ = alpha + qhat + de")
 LAT = ("CY = beta + phat + rhat + da + dr", "Cl = beta + phat + rhat + da + dr", "Cn = beta + phat + rhat + da + dr")
@@ -61,7 +62,7 @@ def correlation_table(campaign: Campaign, cache_dir: str) -> pd.DataFrame:
                 for j, b in enumerate(fit.names):
                     if j > i and "bias" not in (a, b):
                         rows.append({"maneuver": key.maneuver.name, "equation": eq.dependent, "pair": f"{a} / {b}",
-                                     "abs_r": float(abs(r[i, j])), "flagged": bool(abs(r[i, j]) > 0.9)})
+                                     "abs_r": float(abs(r[i, j])), "flagged": bool(abs(r[i, j]) > COLLINEARITY_LIMIT)})
     return pd.DataFrame(rows)
 
 

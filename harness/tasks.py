@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from estimators.least_squares import SingularRegressorsError
-from estimators.methods import make_estimator
+from estimators.methods import make_estimator, method_info
 from estimators.regressors import DataOptions, Equation, EquationError, RegressionData, regression_data
 from harness.campaign import FlightKey, Task
 from harness.noise import apply_noise, output_noise, stream
@@ -18,7 +18,6 @@ from maneuvers.recording import Recording
 from models.constants import SURFACES
 
 LONGITUDINAL = ("CX", "CZ", "Cm", "CL", "CD")
-TIME_DOMAIN = ("ee-time", "ee-smooth")
 ROW_COLUMNS = ["task_id", "campaign", "flight", "aircraft", "variant", "condition", "maneuver", "loop", "noise",
                "realization", "seed", "method", "errors", "equation", "dependent", "parameter", "estimate",
                "std_error", "truth_local", "truth_fit", "time_s", "max_corr", "ok", "message"]
@@ -59,7 +58,8 @@ def excited_equations(rec: Recording, equations: tuple[Equation, ...]) -> tuple[
 def _estimator(task: Task, method: str, errors: str):
     """The estimator for ``method``: the registry's, or a campaign's ``[method_factories]``
     override (``module:callable`` taking the same keywords), e.g. to plant a regression."""
-    kwargs = dict(errors=errors if method in TIME_DOMAIN else "conventional", **estimator_options(task, method))
+    kwargs = dict(errors=errors if method_info(method).supports(errors) else "conventional",
+                  **estimator_options(task, method))
     factory = dict(task.method_factories).get(method)
     if factory is None:
         return make_estimator(method, **kwargs)
@@ -80,22 +80,6 @@ def estimator_options(task: Task, method: str) -> dict:
     if "max_lag" in opts:
         out["max_lag"] = int(opts["max_lag"])
     return out
-
-
-OUTPUT_ERROR = ("oe", "oe-freq", "fe")  # fit the whole model once per flight, whatever the equation
-
-
-def _output_error(method: str, model: str):
-    """The output-error family's estimator of a built-in model: time domain, frequency domain
-    or filter error (process noise)."""
-    if method == "oe-freq":
-        from estimators.frequency_output_error import FrequencyOutputError
-        return FrequencyOutputError(model=model)
-    if method == "fe":
-        from estimators.filter_error import FilterError
-        return FilterError(model=model)
-    from estimators.output_error import OutputError
-    return OutputError(model=model)
 
 
 def _model_of(equation: Equation) -> str:
@@ -187,18 +171,18 @@ def run_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
     equations = excited_equations(clean, task.equations)
     prepared: dict[Equation, RegressionData] = {}  # one build per equation, shared by the methods
     for method in task.methods:
-        errs = task.errors if method in TIME_DOMAIN else (("cramer-rao",) if method in OUTPUT_ERROR else ("conventional",))
-        for errors in errs:
+        info = method_info(method)
+        for errors in info.error_types(task.errors):
             for eq in equations:
                 base = common | {"method": method, "errors": errors, "equation": eq.describe(),
                                  "dependent": eq.dependent}
                 try:
-                    if method in OUTPUT_ERROR:
+                    if info.whole_model:  # fits its model once per flight, whatever the equation
                         model = _model_of(eq)
                         if (method, model) not in oe_fits:
                             src = noisy  # output error always sees the measured outputs
                             t0 = time.perf_counter()
-                            oe_fits[(method, model)] = (_output_error(method, model).fit(src, eq),
+                            oe_fits[(method, model)] = (make_estimator(method, model=model).fit(src, eq),
                                                         time.perf_counter() - t0)
                         fit, elapsed = oe_fits[(method, model)]
                     else:
@@ -289,7 +273,6 @@ def run_combined_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
     (Eq. 42), sequential a-priori combination with equal (Eqs. 47, 49) and unequal variances
     (Eqs. 45, 48) and frequency-domain combination. A row of method 'check' records the largest
     relative difference between the concatenated and the sequential estimates."""
-    from estimators.multiple import fit_concatenated, fit_frequency_combined, fit_sequential
     t_start = time.perf_counter()
     cleans, noisies, models = [], [], []
     for i, key in enumerate(task.flights):
@@ -312,21 +295,12 @@ def run_combined_task(task: Task, cache_dir: str) -> tuple[pd.DataFrame, float]:
             datasets.append(regression_with_noise(clean, noisy, eq, task.noise.apply_to, sub, model))
         fits = {}
         for method in task.methods:
-            errs = task.errors if method == "ee-concat" else ("conventional",)
-            for errors in errs:
+            for errors in method_info(method).error_types(task.errors):
                 base = common | {"method": method, "errors": errors, "equation": eq.describe(),
                                  "dependent": eq.dependent}
                 t0 = time.perf_counter()
                 try:
-                    if method == "ee-concat":
-                        fit = fit_concatenated(datasets, errors=errors)
-                    elif method == "ee-sequential":
-                        fit = fit_sequential(datasets, equal_variances=True)
-                    elif method == "ee-sequential-unequal":
-                        fit = fit_sequential(datasets, equal_variances=False)
-                    else:
-                        fit = fit_frequency_combined(datasets, **{k: v for k, v in estimator_options(task, method).items()
-                                                                 if k in ("frequencies_hz", "detrend")})
+                    fit = _estimator(task, method, errors).fit(datasets)
                 except (SingularRegressorsError, EquationError, ValueError, np.linalg.LinAlgError) as exc:
                     rows += _failure_rows(base, eq, cleans[0], f"{type(exc).__name__}: {exc}")
                     continue

@@ -13,6 +13,7 @@ from models.atmosphere import Turbulence, start_turbulence
 from models.hidden import apply_sensor_effects, delay_deltas, delay_property, frames_of
 from models.trim import TrimPoint
 from models.constants import G0_FPS2
+from models.axes import wind_axis_coefficients
 
 Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
 
@@ -249,9 +250,7 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
     truth = {
         "CX": CX, "CY": Y / qS, "CZ": CZ,
         "Cl": L / (qS * trim_point.b_ft), "Cm": M / (qS * trim_point.cbar_ft), "Cn": N / (qS * trim_point.b_ft),
-        # Seed Eq. 2
-        "CD": -CX * np.cos(alpha) - CZ * np.sin(alpha),
-        "CL": -CZ * np.cos(alpha) + CX * np.sin(alpha),
+        **wind_axis_coefficients(CX, CZ, alpha),  # seed Eq. 2: CD, CL
         "alphadot": out[:, j + 12],
     }
     return FlightHistory(channels=channels, truth=truth, sample_rate_hz=sample_rate_hz,

@@ -16,7 +16,6 @@ zero (α̇ derivatives are then measured on their own, by switching that gain on
 """
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -29,7 +28,7 @@ from models.aircraft import Aircraft, load_fdm, model_xml, nominal_tree
 from models.conditions import FlightCondition
 from models.jsbsim_root import cached_root
 from models.trim import TrimPoint, place_untrimmed, trim
-from models.constants import COEFFICIENTS
+from models.axes import wind_axis_coefficients
 
 LONGITUDINAL_COEFFICIENTS = ("CL", "CD", "CX", "CZ", "Cm")
 LONGITUDINAL_VARIABLES = ("alpha", "qhat", "de")
@@ -166,7 +165,7 @@ class CoefficientProbe:
         CX, CZ = X / qS, Z / qS
         return {"CX": CX, "CY": Y / qS, "CZ": CZ, "Cl": L / (qS * tp.b_ft),
                 "Cm": M / (qS * tp.cbar_ft), "Cn": N / (qS * tp.b_ft),
-                "CD": -CX * math.cos(a) - CZ * math.sin(a), "CL": -CZ * math.cos(a) + CX * math.sin(a)}
+                **{k: float(v) for k, v in wind_axis_coefficients(CX, CZ, a).items()}}
 
     def unsteady_derivatives(self) -> dict[str, float]:
         """α̇ derivatives (α̇ normalised by c̄/2V): the coefficient change when the gated α̇

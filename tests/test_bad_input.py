@@ -343,6 +343,25 @@ def test_internal_errors_keep_their_traceback(capsys):
     assert "Traceback" in err and "KeyError" in err and "internal error" in err.splitlines()[-1]
 
 
+def test_a_plain_value_error_is_a_bug_and_a_user_error_type_is_not(capsys):
+    """Only the user-error types are user errors; a plain ValueError (an internal bug) keeps its
+    traceback and exits 1, whatever layer raised it."""
+    from models.conditions import ConditionError
+    from models.errors import UserError
+
+    def bug(args):
+        raise ValueError("operands could not be broadcast together")
+    assert run_reporting_errors(bug, None, "estimate") == 1
+    err = capsys.readouterr().err
+    assert "Traceback" in err and "internal error" in err.splitlines()[-1]
+    for kind in (UserError, ConditionError):
+        def mistake(args, kind=kind):
+            raise kind("condition 'h=1': V is missing")
+        assert run_reporting_errors(mistake, None, "fly") == 2
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and err.strip() == "sidbench fly: error: condition 'h=1': V is missing"
+
+
 def test_debug_shows_the_traceback_of_a_user_error(tmp_path, capsys):
     (tmp_path / "x.csv").mkdir()
     assert main(["--debug", *_estimate(tmp_path / "x.csv")]) == 2
