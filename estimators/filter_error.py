@@ -174,6 +174,9 @@ position noise alone takes the gust model's Cm coverage from 0.93–0.98 to 0.68
 the lateral model (not studied)."""
 
 MAD_TO_SIGMA = 0.6744897501960817  # median |N(0, 1)|
+GUST_FLOOR = 1e-4
+"""The gust's smallest standard deviation, as a fraction of output error's residual standard
+deviation of the disturbed state: there the gust is "none" (held, and reported so)."""
 
 
 def input_noise_std(u: np.ndarray) -> np.ndarray:
@@ -307,7 +310,8 @@ class FilterError:
         gust as α_g = w_g/V) or ``'beta'``; its σ and τ are estimated (``ln_sigma_gust``,
         ``ln_tau_gust``); None: no gust state; ``'default'``: :data:`GUST_DEFAULT` of the model
         (α for the short period — on the ``turbulence`` campaign white noise on α and q covered
-        Cm_α 0.82, on α alone 0.68, the gust state 0.9x: README).
+        Cm_α 0.82, on α alone 0.68, the gust state with the stabilator's noise (the defaults)
+        0.92–0.97 for all six derivatives: README).
     gust_tau_start_s : the gust time constant τ the fit starts from, s (the gust σ starts at
         output error's residual standard deviation of the disturbed state).
     input_noise : the inputs measured with white noise (FE-5): that noise enters the state
@@ -379,7 +383,7 @@ class FilterError:
         if gust is not None:
             r_gust = R0[spec.state_outputs[lay.gust]]
             theta[lay.sigma] = 0.5 * np.log(r_gust)
-            lower[lay.sigma] = 0.5 * np.log(r_gust) - np.log(1e4)  # a gust 1e-4 of the residual: none
+            lower[lay.sigma] = 0.5 * np.log(r_gust) + np.log(GUST_FLOOR)
             tb = self.tau_bounds_s if self.tau_bounds_s is not None else (dt, 10.0 * N * dt)
             lower[lay.tau], upper[lay.tau] = np.log(tb[0]), np.log(tb[1])
             theta[lay.tau] = np.clip(np.log(self.gust_tau_start_s), lower[lay.tau], upper[lay.tau])
@@ -557,8 +561,8 @@ class FilterError:
         if not converged:
             warnings.append(f"filter error did not converge in {it} iterations")
         if gust is not None and not keep[lay.sigma]:
-            warnings.append(f"no gust in these data: its standard deviation is at its floor (1e-4 of {gust}'s "
-                            "output-error residual), so ln_sigma_gust and ln_tau_gust have no standard error "
+            warnings.append(f"no gust in these data: its standard deviation is at its floor ({GUST_FLOOR:g} of "
+                            f"{gust}'s output-error residual), so ln_sigma_gust and ln_tau_gust have no standard error "
                             "(gust=None fits without the gust state)")
         r2 = {o: 1 - float(np.sum(nu[:, i] ** 2) / np.sum((z[:, i] - z[:, i].mean()) ** 2))
               for i, o in enumerate(spec.outputs)}
