@@ -200,3 +200,20 @@ def test_mass_and_reference_point_adjustments_reach_jsbsim(tmp_path):
     share = n["inertia/empty-weight-lbs"] / n["inertia/weight-lbs"]
     assert c["inertia/cg-x-in"] - n["inertia/cg-x-in"] == pytest.approx(3.0 * share, rel=1e-6)
     assert c["inertia/iyy-slugs_ft2"] > 1.5 * n["inertia/iyy-slugs_ft2"]
+
+
+def test_coloured_middle_matrix_equals_its_definition():
+    """Σ_{o,o'} X_oᵀ T_oo' X_o' by FFT equals the double sum over samples with the residuals'
+    all-lag auto- and cross-correlations ĉ_oo'(k) = (1/N) Σ_n v_o[n + k] v_o'[n]."""
+    from harness.calibrate.engine import colored_middle
+    rng = np.random.default_rng(2)
+    n, p, no = 40, 3, 2
+    S, v, R = rng.standard_normal((p, n, no)), rng.standard_normal((n, no)), np.array([0.5, 2.0])
+    X = S / R
+    want = np.zeros((p, p))
+    for o in range(no):
+        for o2 in range(no):
+            c = {k: sum(v[m + k, o] * v[m, o2] for m in range(n) if 0 <= m + k < n) / n for k in range(-n + 1, n)}
+            T = np.array([[c[i - j] for j in range(n)] for i in range(n)])
+            want += X[:, :, o] @ T @ X[:, :, o2].T
+    assert np.allclose(colored_middle([S], [v], R), want, rtol=1e-10, atol=1e-10)

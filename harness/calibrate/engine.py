@@ -16,11 +16,11 @@ come from perturbed flights, h_j = 1 % of max(|θ_j|, typical_j) (JSBSim's trim 
 to a tolerance: a smaller step differences its noise). All flights of one evaluation run
 through the executor at once. The covariance is the Cramér-Rao bound M⁻¹ and, since
 residuals of a model flown against real sensors are coloured, its correction for coloured
-residuals (Eq. 40 generalised to output error, per output o):
+residuals (Eq. 40 generalised to output error and several outputs):
 
-    Cov = M⁻¹ [Σ_o X_oᵀ T_o X_o] M⁻¹,   X_o = S_o / R_oo,   T_o[i, j] = R̂_vv,o(i − j),
+    Cov = M⁻¹ [Σ_{o,o'} X_oᵀ T_oo' X_o'] M⁻¹,   X_o = S_o / R_oo,   T_oo'[i, j] = ĉ_oo'(i − j),
 
-with R̂_vv,o the residual autocorrelation (Eq. 39, all lags), evaluated by FFT.
+with ĉ the residual auto- and cross-correlations (Eq. 39, all lags), evaluated by FFT.
 """
 from __future__ import annotations
 
@@ -144,22 +144,26 @@ def information(S: list[np.ndarray], v: list[np.ndarray], R: np.ndarray) -> tupl
 
 
 def colored_middle(S: list[np.ndarray], v: list[np.ndarray], R: np.ndarray) -> np.ndarray:
-    """Σ_m Σ_o X_moᵀ T_mo X_mo (module docstring) by FFT, all lags: for columns a, b of X and a
-    kernel with spectrum |V(f)|²/N, Σ_ij a_i R̂(i − j) b_j = (1/L) Σ_f A(f) conj(B(f)) |V(f)|²/N."""
+    """Σ_m Σ_{o,o'} X_moᵀ T_m,oo' X_mo' (module docstring), the residuals' auto- and
+    cross-correlations at all lags (Eq. 39, ĉ_oo'(k) = (1/N) Σ_n v_o[n + k] v_o'[n]) included:
+    the noise a replay's recorded inputs carry reaches several outputs at once.
+
+    By the correlation theorem, with zero-padded transforms of length L ≥ 2N − 1,
+    Σ_ij a_oi ĉ_oo'(i − j) b_o'j = (1/(L N)) Σ_f conj(A_o(f)) V_o(f) conj(V_o'(f)) B_o'(f), so the
+    whole matrix is (1/(L N)) Σ_f W(f) W(f)ᴴ with W_j(f) = Σ_o conj(A_oj(f)) V_o(f)."""
     p = S[0].shape[0]
     out = np.zeros((p, p))
     for Sm, vm in zip(S, v):
         n = vm.shape[0]
         L = sfft.next_fast_len(2 * n)
-        for o in range(vm.shape[1]):
-            X = Sm[:, :, o] / R[o]
-            A = sfft.rfft(X, L, axis=1)
-            P = np.abs(sfft.rfft(vm[:, o], L)) ** 2 / n
-            wts = np.full(A.shape[1], 2.0)
-            wts[0] = 1.0
-            if L % 2 == 0:
-                wts[-1] = 1.0
-            out += np.real((A * (P * wts)) @ A.conj().T) / L
+        A = sfft.rfft(Sm / R, L, axis=1)          # p × F × n_o
+        V = sfft.rfft(vm, L, axis=0)              # F × n_o
+        W = np.einsum("pfo,fo->pf", A.conj(), V)
+        wts = np.full(W.shape[1], 2.0)
+        wts[0] = 1.0
+        if L % 2 == 0:
+            wts[-1] = 1.0
+        out += np.real((W * wts) @ W.conj().T) / (L * n)
     return out
 
 
