@@ -5,6 +5,7 @@ import argparse
 from collections.abc import Callable
 from pathlib import Path
 
+from harness.atomic import ensure_folder
 from harness.calibrate.output import write_calibration
 from harness.calibrate.run import calibrate
 
@@ -13,6 +14,7 @@ def cmd_calibrate(args: argparse.Namespace, write_report: Callable[[Path], objec
     """Calibrate, write OUT/calibration.json, OUT/model/, OUT/series/ and, with ``write_report``
     (the command line passes :func:`reports.calibration_report.write_calibration_report`: the
     harness never imports the reports package), OUT/report.html."""
+    ensure_folder(args.out, "--out folder")  # refused before the flights, not after
     outputs = tuple(s.strip() for s in args.outputs.split(",") if s.strip()) if args.outputs else None
     result = calibrate(args.model, args.recording, args.parameters, validation=args.validation, outputs=outputs,
                        workers=args.workers, mass=args.mass, max_iterations=args.max_iterations,
