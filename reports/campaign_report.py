@@ -144,11 +144,6 @@ def summary_table(scores: pd.DataFrame, bias_limit: float) -> Table:
                  "unbiased estimates with honest bounds.", hl)
 
 
-def summary_lines(out: CampaignOutput) -> list[str]:
-    """The lead lines of the campaign's report (see :func:`reports.lead.lead_lines`)."""
-    return lead_lines(out, find(out.truth_scores), read_setup(out.meta))
-
-
 def _figs(*items):
     return tuple(f for f in items if f is not None)
 
@@ -159,9 +154,8 @@ def campaign_sections(out: CampaignOutput, findings: Findings | None = None,
     model fit, maneuvers, differentiation."""
     s = out.truth_scores
     f = findings if findings is not None else find(s)
-    eff = efficiency_note(s)
     sections = [Section("Methods at a glance", (), (summary_table(s, f.bias_limit),) if not s.empty else ()),
-                Section("Accuracy and honesty", (eff,) if eff else (),
+                Section("Accuracy and honesty", (),
                         (accuracy_table(s, f.bias_limit, gates), honesty_table(s, gates)),
                         _figs(F.fig_bias(s), F.fig_coverage(s), F.fig_se_ratio(s), F.fig_efficiency(s),
                               F.fig_scatter(out.results, s)))]

@@ -252,7 +252,8 @@ def fig_trend(history: pd.DataFrame | None, nights: int = 30, nominal: float = 0
         span = ax2.get_xticklabels()[0].get_text() + " UTC"
         change = " Only one run so far: the trend starts with the next one." + change
     caption = (f"Median over parameters of each method's coverage (top, nominal {nominal:g} dashed) and of its "
-               f"|bias| in Monte Carlo standard errors (bottom, 2 dotted), per nightly run ({len(runs)} run{'s' if len(runs) > 1 else ''}, {span}); "
+               f"|bias| in Monte Carlo standard errors (bottom, 2 dotted), per nightly run "
+               f"({len(runs)} run{'s' if len(runs) > 1 else ''}, {span}); "
                "a step down in coverage or up in |bias z| flags a regression." + change + more)
     alt = (f"Two line charts over {len(runs)} runs of median coverage and median absolute bias z for "
            f"{', '.join(series)}.")

@@ -6,11 +6,15 @@ import numpy as np
 import pandas as pd
 
 from reports import figures as F
-from reports.campaign_report import GATE_KEYS, campaign_sections, summary_lines
+from reports.campaign_report import GATE_KEYS, campaign_sections
+from reports.campaign_setup import read_setup
 from reports.findings import find, status_of
-from reports.lead import findings_section, status_note
+from reports.lead import findings_section, lead_lines, status_note
 from reports.load import CampaignOutput, provenance
 from reports.render import Report, Section, Table
+
+NIGHTLY_LEAD_LINES: int = 6
+"""Lines of the campaign lead (verdict, largest bias, cases, coverage) after the gate verdict."""
 
 
 def history_frame(history: list) -> pd.DataFrame:
@@ -62,12 +66,12 @@ def nightly_report(out: CampaignOutput, gates: pd.DataFrame, history: list, prev
     findings = find(out.truth_scores)
     status = status_of(findings, len(failed))
     verdict = "FAIL" if len(failed) else "PASS"
-    summary = [f"{verdict}: {len(gates) - len(failed)} of {len(gates)} gated cells pass"
-               + (f"; compared with run {previous['run_id']}" if previous else "; no previous run to compare with") + "."]
+    compared = f"compared with run {previous['run_id']}" if previous else "no previous run to compare with"
+    summary = [f"{verdict}: {len(gates) - len(failed)} of {len(gates)} gated cells pass; {compared}."]
     summary += [f"{r['gate']}: {r['message']}" for _, r in failed.head(8).iterrows()]
     if len(failed) > 8:
         summary.append(f"... and {len(failed) - 8} more failures (see the gate table).")
-    summary += [line for line in summary_lines(out)[2:6]]
+    summary += lead_lines(out, findings, read_setup(out.meta))[2:NIGHTLY_LEAD_LINES + 2]
     full = gate_rows(gates, out.truth_scores).head(300)
     hl = tuple((i, "passed", "bad" if not r["passed"] else "good") for i, r in full.iterrows())
     moved = gates[(gates["kind"] == "movement") & ~gates["passed"]] if not gates.empty else gates

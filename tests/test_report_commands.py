@@ -40,7 +40,8 @@ def test_report_command_writes_three_formats(campaign_dir, capsys):
     out = capsys.readouterr().out
     assert "# Campaign report: report-test" in out
     html = (campaign_dir / "report.html").read_text()
-    for needle in ('id="table-scores-accuracy"', 'id="table-scores-honesty-of-the-bounds"', "data:image/png;base64,", "<figcaption", "report-test", "Seed"):
+    for needle in ('id="table-scores-accuracy"', 'id="table-scores-honesty-of-the-bounds"', "data:image/png;base64,",
+                   "<figcaption", "report-test", "Seed"):
         assert needle in html, needle
     d = json.loads((campaign_dir / "report.json").read_text())
     assert d["kind"] == "campaign" and d["numbers"]["scores"] and d["provenance"]["seed"] == 3
