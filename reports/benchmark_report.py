@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 
 from reports import figures as F
+from reports.findings import rough_note
 from reports.load import CampaignOutput, provenance
 from reports.render import Report, Section, Table
 
@@ -81,11 +82,14 @@ def benchmark_report(outputs: list[CampaignOutput]) -> Report:
     ov = overall(s)
     best = ov.iloc[0] if len(ov) else None
     summary = [f"{len(s)} scored cells from {', '.join(o.meta['campaign']['name'] for o in outputs)}."]
+    rough = rough_note(int(s["n"].min())) if "n" in s and len(s) else ""
     if best is not None:
         summary.append(f"Most accurate overall: {best['method_label']} (mean RMSE rank {best['mean_rank_rmse']:.2f}, "
                        f"median relative RMSE {best['median_rel_rmse_pct']:.1f} %, {best['mean_time_ms']:.1f} ms per estimate).")
         h = ov.sort_values("mean_rank_honesty").iloc[0]
         summary.append(f"Most honest bounds: {h['method_label']} (median coverage {h['median_coverage']:.2f}).")
+    if rough:
+        summary.append(rough)
     sections = [
         Section("Overall ranking", ("Ranks are 1 for the best method in each case and parameter, averaged.",),
                 (Table("Methods", ov, "Lower ranks are better; coverage near 0.95 means honest bounds."),),

@@ -27,7 +27,7 @@ from harness.gates import family_z
 
 __all__ = ["BIAS_FALSE_ALARM", "COVERAGE_BAND", "MIN_REALIZATIONS", "METHOD_LABELS", "CASE_COLUMNS",
            "Findings", "find", "one_per_estimate", "bias_tests", "bias_findings", "coverage_failures", "case_columns",
-           "comparison", "method_label", "status_of", "efficiency_note"]
+           "comparison", "method_label", "rough_note", "status_of", "efficiency_note"]
 
 BIAS_FALSE_ALARM: float = 0.01
 """Family-wise false-alarm rate of the bias findings (the nightly ``unbiased`` gate's)."""
@@ -169,6 +169,15 @@ def find(scores: pd.DataFrame, false_alarm: float = BIAS_FALSE_ALARM,
     return Findings(tests=tests, bias_limit=limit, biases=biases, coverage=coverage_failures(scores, band),
                     cells_with_coverage=covered, comparison=comparison(tests, cases), cases=cases,
                     min_n=int(n.min()) if len(n) else 0)
+
+
+def rough_note(n: int) -> str:
+    """The caveat for conclusions from ``n`` < :data:`MIN_REALIZATIONS` realizations per cell, or ''."""
+    if not 0 < n < MIN_REALIZATIONS:
+        return ""
+    half = 1.96 * math.sqrt(0.95 * 0.05 / n)
+    return (f"Only {n} realizations per cell (fewer than {MIN_REALIZATIONS}): these conclusions are rough "
+            f"(a coverage of 0.95 is known to ±{half:.2f}; run more realizations before relying on them).")
 
 
 def status_of(findings: Findings | None, failed_gates: int = 0) -> str:

@@ -2,15 +2,13 @@
 largest first, in sentences and small tables (the rules are in :mod:`reports.findings`)."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
 from harness.campaign import NoiseDef
 from reports.campaign_setup import Setup, flown_text, noise_table
 from reports.figures_common import KNOWN_METHODS
-from reports.findings import COVERAGE_BAND, MIN_REALIZATIONS, Findings, method_label
+from reports.findings import COVERAGE_BAND, Findings, method_label, rough_note
 from reports.load import CampaignOutput
 from reports.render import Section, Table
 
@@ -135,12 +133,8 @@ def _coverage_line(f: Findings) -> str:
 
 
 def few_realizations_note(f: Findings) -> str:
-    """The caveat for fewer than :data:`MIN_REALIZATIONS` realizations, or ''."""
-    if not f.few_realizations:
-        return ""
-    half = 1.96 * math.sqrt(0.95 * 0.05 / f.min_n)
-    return (f"Only {f.min_n} realizations per cell (fewer than {MIN_REALIZATIONS}): these conclusions are rough "
-            f"(a coverage of 0.95 is known to ±{half:.2f}; run more realizations before relying on them).")
+    """The caveat for fewer than :data:`reports.findings.MIN_REALIZATIONS` realizations, or ''."""
+    return rough_note(f.min_n)
 
 
 def _run_line(out: CampaignOutput) -> str:

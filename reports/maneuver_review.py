@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 
 from reports import figures as F
+from reports.findings import rough_note
 from reports.load import CampaignOutput, provenance
 from reports.render import Report, Section, Table
 
@@ -83,5 +84,6 @@ def maneuver_review(out: CampaignOutput, corr: pd.DataFrame) -> Report:
     ]
     numbers = {k: (v.reset_index() if k in ("crb", "accuracy") else v).replace({np.nan: None}).to_dict(orient="records")
                for k, v in t.items()} | {"recommendations": rec}
+    rough = rough_note(int(out.meta["campaign"].get("realizations") or 0))
     return Report(title="Maneuver design review", kind="maneuver-review", provenance=provenance(out.meta),
-                  summary=tuple(rec), sections=tuple(sections), numbers=numbers)
+                  summary=tuple(rec) + ((rough,) if rough else ()), sections=tuple(sections), numbers=numbers)

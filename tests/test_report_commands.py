@@ -55,6 +55,7 @@ def test_benchmark_report(campaign_dir, tmp_path):
     d = json.loads((tmp_path / "benchmark.json").read_text())
     methods = {r["method_label"] for r in d["numbers"]["overall"]}
     assert {"ee-time (conventional)", "ee-freq (conventional)", "oe (cramer-rao)"} <= methods
+    assert any(line.startswith("Only 4 realizations per cell (fewer than 30)") for line in d["summary"])
 
 
 def test_review_maneuvers_recommends_with_numbers(tmp_path, capsys):
@@ -64,6 +65,7 @@ def test_review_maneuvers_recommends_with_numbers(tmp_path, capsys):
     d = json.loads((tmp_path / "review" / "review.json").read_text())
     rec = d["numbers"]["recommendations"]
     assert len(rec) == 1 and rec[0].startswith("Longitudinal") and "Cramér-Rao" in rec[0] and "alpha" in rec[0]
+    assert d["summary"][-1].startswith("Only 3 realizations per cell (fewer than 30)")
     titles = [s["title"] for s in d["sections"]]
     assert "Regressor correlation (seed Eq. 50)" in titles and "Excursions from trim" in titles
 
