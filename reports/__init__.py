@@ -5,6 +5,8 @@
 - :mod:`reports.render`          the format-free document model
 - :mod:`reports.html`, :mod:`reports.markdown`, :mod:`reports.jsonreport`  the three formats
 - :mod:`reports.campaign_report` any campaign's report (``sidbench report DIR``)
+- :mod:`reports.findings`        what the scores show, ranked: biases, coverage failures, comparison
+- :mod:`reports.lead`, :mod:`reports.campaign_setup`  the report's lead lines and set-up section
 - :mod:`reports.nightly_report`  the nightly accuracy report with gates and trends
 - :mod:`reports.benchmark_report` methods ranked by accuracy, honesty and cost
 - :mod:`reports.maneuver_review` the maneuver design review
