@@ -109,5 +109,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
     report = campaign_report(read_output(out / "campaign"))
     html = write_all(report, out)
     print(f"{run.meta['estimates']} estimates in {run.meta['wall_s']:.1f} s on {run.meta['executor']}.")
+    print(f"\n{report.status.upper()} ({report.status_note})")
+    for line in report.summary[1:-1]:  # the report's lead: what was flown (not the F-16 above) and what it found
+        print(f"- {line}")
     print(f"\nReport: {html.resolve()}")
     return 0
