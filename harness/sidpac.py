@@ -38,6 +38,7 @@ Mapping
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -189,6 +190,35 @@ def import_sidpac(path: str | Path) -> Recording:
     source = str(path)
     if not path.is_file():
         raise FileNotFoundError(f"{source}: no such SIDPAC file")
+    file = _read_sidpac(path)
+    cols = _Columns(channels={"t_s": file.t})
+    for j, (label, unit) in enumerate(zip(file.labels, file.units)):
+        cols.take(j + 1, label, unit, file.fdata[:, j], source)
+    if cols.blank:
+        cols.dropped.append(f"{cols.blank} blank-labelled all-zero column(s)")
+    _derive_qbar(cols, source)
+    geometry = _geometry(file, cols)
+    _check_time_column(file, cols)
+    frame = to_canonical(pd.DataFrame(cols.channels), source)
+    return Recording(frame, _meta(path, file, cols, geometry), name=path.stem).validate(source)
+
+
+@dataclass
+class _SidpacFile:
+    """The parts of a SIDPAC file the import reads, checked for shape."""
+
+    mat: dict[str, Any]
+    fds: Any
+    fdata: np.ndarray
+    t: np.ndarray
+    labels: list[str]
+    units: list[str]
+
+
+def _read_sidpac(path: Path) -> _SidpacFile:
+    """Load the file and check it holds ``fds`` (labels, units), ``fdata`` and ``t`` of agreeing
+    sizes, with no label used twice."""
+    source = str(path)
     mat = _load_mat(path)
     fds = mat.get("fds")
     if fds is None or not hasattr(fds, "varlab"):
@@ -224,153 +254,179 @@ def import_sidpac(path: str | Path) -> Recording:
     if dupes:
         raise RecordingError(f"labels used by more than one column: {dupes}", source=source,
                              key="fds.varlab", rule="duplicate-quantity")
+    return _SidpacFile(mat, fds, fdata, t, labels, units)
 
-    notes: list[str] = []
-    dropped: list[str] = []
-    provenance: dict[str, int | str] = {}
-    channels: dict[str, np.ndarray] = {"t_s": t}
-    mass_meta: dict[str, float] = {}
-    cg: dict[str, Any] = {}
-    geometry_columns: dict[str, float] = {}
+
+@dataclass
+class _Columns:
+    """What the fdata columns become: channels, mass properties, the c.g., geometry columns, the
+    air density, the start time, and the notes, dropped columns and provenance that say so."""
+
+    channels: dict[str, np.ndarray] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    dropped: list[str] = field(default_factory=list)
+    provenance: dict[str, int | str] = field(default_factory=dict)
+    mass_meta: dict[str, float] = field(default_factory=dict)
+    cg: dict[str, Any] = field(default_factory=dict)
+    geometry_columns: dict[str, float] = field(default_factory=dict)
     rho: np.ndarray | None = None
     start_time: float | None = None
-    blank = 0
+    blank: int = 0
 
-    for j, (label, unit) in enumerate(zip(labels, units)):
-        number = j + 1
-        values = fdata[:, j]
+    def take(self, number: int, label: str, unit: str, values: np.ndarray, source: str) -> None:
+        """Column ``number`` (1-based): a format channel, a mass property, metadata, an extra
+        channel, or dropped, with the reason."""
         all_zero = not np.any(values)
         where = f"column {number} ({label!r}, unit {unit!r})"
         if not label:
             if all_zero:
-                blank += 1
+                self.blank += 1
             else:
-                dropped.append(f"column {number}: unlabelled, not all zero")
-            continue
-        if label == "time":
-            start_time = float(values[0])
-            continue
-        if label in _GEOMETRY_FIELDS:
+                self.dropped.append(f"column {number}: unlabelled, not all zero")
+        elif label == "time":
+            self.start_time = float(values[0])
+        elif label in _GEOMETRY_FIELDS:
             if _is_constant(values):
-                geometry_columns[_GEOMETRY_FIELDS[label]] = float(values[0])
-            continue
-        if label in _CG_LABELS:
-            cg[f"{label}_in"] = (float(values[0]) if _is_constant(values) else
-                                 {"min": float(values.min()), "max": float(values.max()),
-                                  "mean": float(values.mean())})
-            continue
-        if label == "rho":
+                self.geometry_columns[_GEOMETRY_FIELDS[label]] = float(values[0])
+        elif label in _CG_LABELS:
+            self.cg[f"{label}_in"] = (float(values[0]) if _is_constant(values) else
+                                      {"min": float(values.min()), "max": float(values.max()),
+                                       "mean": float(values.mean())})
+        elif label == "rho":
             if not all_zero:
-                rho = values
-            dropped.append(f"{where}: air density is not a channel of the format")
-            continue
+                self.rho = values
+            self.dropped.append(f"{where}: air density is not a channel of the format")
+        elif label in _LABEL_TO_QUANTITY:
+            self._format_channel(number, label, unit, values, where, source)
+        else:
+            self._extra_channel(number, label, unit, values, where)
+
+    def _format_channel(self, number: int, label: str, unit: str, values: np.ndarray, where: str,
+                        source: str) -> None:
+        """A column of a quantity the format knows, converted, signed to the format's convention."""
+        quantity = _LABEL_TO_QUANTITY[label]
         fmt_unit = _SIDPAC_UNITS.get(unit)
-        quantity = _LABEL_TO_QUANTITY.get(label)
-        if quantity is not None:
-            spec = CHANNELS[quantity]
-            if fmt_unit is None or fmt_unit not in spec.units:
-                raise RecordingError(
-                    f"unit {unit!r} cannot be converted to {spec.canonical!r} for {quantity!r}",
-                    source=source, key=where, rule="unknown-unit",
-                )
-            if quantity == "qbar" and all_zero:
-                notes.append(f"qbar ({where}) is all zero, impossible in flight: treated as absent.")
-                continue
-            if all_zero and quantity not in REQUIRED_QUANTITIES:
-                dropped.append(f"{where}: all zero")
-                continue
-            name = f"{quantity}_{fmt_unit}"
-            if quantity in _MASS_QUANTITIES and _is_constant(values):
-                mass_meta[spec.column] = float(values[0]) * spec.units[fmt_unit]
-                provenance[f"meta.mass.{spec.column}"] = number
-                continue
-            sign = _SIGN_TO_FORMAT.get(label, 1.0)
-            if sign != 1.0:
-                notes.append(f"{quantity} is {where} negated: SIDPAC's positive {label} rolls the aircraft left, the "
-                             "format's (JSBSim's) rolls it right.")
-            channels[name] = sign * values
-            provenance[spec.column] = number
-            continue
-        # An extra channel: keep it in canonical units when the unit is known.
-        if all_zero:
-            dropped.append(f"{where}: all zero")
-            continue
+        spec = CHANNELS[quantity]
+        if fmt_unit is None or fmt_unit not in spec.units:
+            raise RecordingError(
+                f"unit {unit!r} cannot be converted to {spec.canonical!r} for {quantity!r}",
+                source=source, key=where, rule="unknown-unit",
+            )
+        all_zero = not np.any(values)
+        if quantity == "qbar" and all_zero:
+            self.notes.append(f"qbar ({where}) is all zero, impossible in flight: treated as absent.")
+            return
+        if all_zero and quantity not in REQUIRED_QUANTITIES:
+            self.dropped.append(f"{where}: all zero")
+            return
+        if quantity in _MASS_QUANTITIES and _is_constant(values):
+            self.mass_meta[spec.column] = float(values[0]) * spec.units[fmt_unit]
+            self.provenance[f"meta.mass.{spec.column}"] = number
+            return
+        sign = _SIGN_TO_FORMAT.get(label, 1.0)
+        if sign != 1.0:
+            self.notes.append(f"{quantity} is {where} negated: SIDPAC's positive {label} rolls the aircraft left, "
+                              "the format's (JSBSim's) rolls it right.")
+        self.channels[f"{quantity}_{fmt_unit}"] = sign * values
+        self.provenance[spec.column] = number
+
+    def _extra_channel(self, number: int, label: str, unit: str, values: np.ndarray, where: str) -> None:
+        """A column the format does not define: kept in canonical units when the unit is known."""
+        if not np.any(values):
+            self.dropped.append(f"{where}: all zero")
+            return
         if label in CHANNELS or label.startswith("truth_") or not label.replace("_", "").isalnum():
-            dropped.append(f"{where}: label cannot name an extra channel")
-            continue
+            self.dropped.append(f"{where}: label cannot name an extra channel")
+            return
+        fmt_unit = _SIDPAC_UNITS.get(unit)
         if unit == "in":
             canon, factor = "ft", _IN_FT
         else:
             conv = _canonical_extra(fmt_unit) if fmt_unit is not None else None
             if conv is None:
-                dropped.append(f"{where}: unit not known to the format")
-                continue
+                self.dropped.append(f"{where}: unit not known to the format")
+                return
             canon, factor = conv
         name = f"{label}_{canon}"
-        channels[name] = values * factor if factor != 1.0 else values
-        provenance[name] = number
+        self.channels[name] = values * factor if factor != 1.0 else values
+        self.provenance[name] = number
 
-    if blank:
-        dropped.append(f"{blank} blank-labelled all-zero column(s)")
 
+def _derive_qbar(cols: _Columns, source: str) -> None:
+    """Dynamic pressure, when the file lacks it: 0.5 ρ V² from its ρ and V, or 0.5 γ p M² from
+    its Mach number and (pressure) altitude; an error when neither is possible."""
     qbar_col = CHANNELS["qbar"].column
-    if qbar_col not in channels:
-        v = channels.get("V_fps")
-        if rho is not None and v is not None:
-            channels["qbar_psf"] = 0.5 * rho * v**2
-            notes.append("qbar_psf computed as 0.5*rho*V^2 from the file's rho and V columns.")
-        elif "mach_1" in channels and "h_ft" in channels:
-            mach, h = channels["mach_1"], channels["h_ft"]
-            try:
-                p_psf = isa_pressure_psf(h)
-            except ValueError as exc:
-                raise RecordingError(f"cannot derive qbar: {exc}", source=source,
-                                     key=_col_name(qbar_col), rule="missing-channel") from None
-            channels["qbar_psf"] = 0.5 * _GAMMA_AIR * p_psf * mach**2
-            note = ("qbar_psf computed as 0.5*gamma*p*M^2 (gamma 1.4) from the file's mach and alt, "
-                    "alt taken as pressure altitude and p the ISA static pressure at it")
-            if v is not None:
-                # Consistency check: the static temperature implied by V/M vs the ISA's.
-                a_fps = v / mach
-                t_implied = np.mean((a_fps * _FT_M) ** 2 / (_GAMMA_AIR * _ISA_R_J_PER_KG_K))
-                h_m = np.mean(h) * _FT_M
-                t_isa = isa.T0_K - isa.LAPSE_K_PER_M * min(h_m, isa.TROPOPAUSE_M)
-                note += (f"; check: static temperature implied by V/mach {t_implied:.1f} K, "
-                         f"ISA at mean altitude {t_isa:.1f} K")
-            notes.append(note + ".")
-        else:
-            raise RecordingError(
-                "dynamic pressure is missing (or all zero) and cannot be derived: needs rho and V, "
-                "or mach and alt",
-                source=source, key=_col_name(qbar_col), rule="missing-channel",
-            )
-        provenance[qbar_col] = "derived"
+    channels = cols.channels
+    if qbar_col in channels:
+        return
+    v = channels.get("V_fps")
+    if cols.rho is not None and v is not None:
+        channels["qbar_psf"] = 0.5 * cols.rho * v**2
+        cols.notes.append("qbar_psf computed as 0.5*rho*V^2 from the file's rho and V columns.")
+    elif "mach_1" in channels and "h_ft" in channels:
+        mach, h = channels["mach_1"], channels["h_ft"]
+        try:
+            p_psf = isa_pressure_psf(h)
+        except ValueError as exc:
+            raise RecordingError(f"cannot derive qbar: {exc}", source=source,
+                                 key=_col_name(qbar_col), rule="missing-channel") from None
+        channels["qbar_psf"] = 0.5 * _GAMMA_AIR * p_psf * mach**2
+        note = ("qbar_psf computed as 0.5*gamma*p*M^2 (gamma 1.4) from the file's mach and alt, "
+                "alt taken as pressure altitude and p the ISA static pressure at it")
+        if v is not None:
+            # Consistency check: the static temperature implied by V/M vs the ISA's.
+            a_fps = v / mach
+            t_implied = np.mean((a_fps * _FT_M) ** 2 / (_GAMMA_AIR * _ISA_R_J_PER_KG_K))
+            h_m = np.mean(h) * _FT_M
+            t_isa = isa.T0_K - isa.LAPSE_K_PER_M * min(h_m, isa.TROPOPAUSE_M)
+            note += (f"; check: static temperature implied by V/mach {t_implied:.1f} K, "
+                     f"ISA at mean altitude {t_isa:.1f} K")
+        cols.notes.append(note + ".")
+    else:
+        raise RecordingError(
+            "dynamic pressure is missing (or all zero) and cannot be derived: needs rho and V, "
+            "or mach and alt",
+            source=source, key=_col_name(qbar_col), rule="missing-channel",
+        )
+    cols.provenance[qbar_col] = "derived"
 
+
+def _geometry(file: _SidpacFile, cols: _Columns) -> dict[str, float]:
+    """S, b and c̄ from ``fds`` (or a variable of the file), else from constant fdata columns."""
     geometry: dict[str, float] = {}
     for field_name, key in _GEOMETRY_FIELDS.items():
-        value = _number(getattr(fds, field_name, None))
+        value = _number(getattr(file.fds, field_name, None))
         if value is None:
-            value = _number(mat.get(field_name))
-        if value is None and key in geometry_columns:
-            value = geometry_columns[key]
-            notes.append(f"geometry {key} taken from fdata column {field_name!r} (fds.{field_name} absent).")
+            value = _number(file.mat.get(field_name))
+        if value is None and key in cols.geometry_columns:
+            value = cols.geometry_columns[key]
+            cols.notes.append(f"geometry {key} taken from fdata column {field_name!r} (fds.{field_name} absent).")
         if value is not None:
             geometry[key] = value
-            col = geometry_columns.get(key)
+            col = cols.geometry_columns.get(key)
             if col is not None and abs(col - value) > 1e-9 * abs(value):
-                notes.append(f"geometry {key}: fds.{field_name}={value!r} but fdata column has {col!r}; "
-                             "used fds.")
+                cols.notes.append(f"geometry {key}: fds.{field_name}={value!r} but fdata column has {col!r}; "
+                                  "used fds.")
+    return geometry
 
-    if start_time is not None and t.size:
-        dev = float(np.max(np.abs((fdata[:, labels.index("time")] - start_time) - (t - t[0]))))
+
+def _check_time_column(file: _SidpacFile, cols: _Columns) -> None:
+    """A note when fdata's own time column disagrees with ``t`` (``t`` is used)."""
+    t = file.t
+    if cols.start_time is not None and t.size:
+        dev = float(np.max(np.abs((file.fdata[:, file.labels.index("time")] - cols.start_time) - (t - t[0]))))
         if dev > 1e-6:
-            notes.append(f"the time column differs from t by up to {dev:.3g} s; t used.")
+            cols.notes.append(f"the time column differs from t by up to {dev:.3g} s; t used.")
 
+
+def _meta(path: Path, file: _SidpacFile, cols: _Columns, geometry: dict[str, float]) -> dict[str, Any]:
+    """The recording's metadata: the format keys, the file's details and every note of the import."""
+    fds, notes = file.fds, cols.notes
     aircraft = _text(getattr(fds, "aircraft", "")).strip()
     maneuver = _text(getattr(fds, "maneuver", "")).strip()
     description = _text(getattr(fds, "description", "")).strip()
     test_date = _text(getattr(fds, "test_date", "")).strip()
-    varying_mass = [CHANNELS[q].column for q in _MASS_QUANTITIES if CHANNELS[q].column in channels]
+    varying_mass = [CHANNELS[q].column for q in _MASS_QUANTITIES if CHANNELS[q].column in cols.channels]
     if varying_mass:
         notes.append("time-varying mass properties kept as channels: " + ", ".join(varying_mass) + ".")
     notes.append("ax/ay/az are SIDPAC's c.g.-referenced accelerations (accelerometer_ft = [0, 0, 0]); "
@@ -380,12 +436,11 @@ def import_sidpac(path: str | Path) -> Recording:
     notes.append("elevator and rudder signs copied from SIDPAC unchanged: they agree with JSBSim's (trailing edge "
                  "down, and trailing edge left, positive: the Twin Otter's C_n,δr < 0 as in JSBSim's models).")
     notes.append("Ixz copied unchanged: SIDPAC uses the seed's (Eqs. 3-5) sign convention.")
-
-    meta: dict[str, Any] = {
+    return {
         "format": FORMAT_ID,
         "aircraft": aircraft,
         "geometry": geometry,
-        "mass": mass_meta,
+        "mass": cols.mass_meta,
         "sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]},
         "thrust_offset_ft": 0.0,
         "source": (f"SIDPAC file {path.name}: {aircraft}, maneuver {maneuver}, {description}, "
@@ -399,15 +454,13 @@ def import_sidpac(path: str | Path) -> Recording:
             "test_date": test_date,
             "pilot": _text(getattr(fds, "pilot", "")).strip(),
             "created": _text(getattr(fds, "created", "")).strip(),
-            "start_time_s": start_time,
-            "cg_in": cg,
-            "columns": provenance,
-            "dropped": dropped,
+            "start_time_s": cols.start_time,
+            "cg_in": cols.cg,
+            "columns": cols.provenance,
+            "dropped": cols.dropped,
         },
         "import_notes": notes,
     }
-    frame = to_canonical(pd.DataFrame(channels), source)
-    return Recording(frame, meta, name=path.stem).validate(source)
 
 
 def _load_mat(path: Path) -> dict[str, Any]:
