@@ -136,84 +136,119 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         the time, the channel and the value.
     """
     n_sub = frames_per_sample(sample_rate_hz, sim_rate_hz)
-    dt = 1.0 / (n_sub * sample_rate_hz)
-    n_samples = int(round(duration_s * sample_rate_hz)) + 1
-    n_frames = (n_samples - 1) * n_sub
-    fdm.set_dt(dt)
+    frames = _Frames(n_sub, 1.0 / (n_sub * sample_rate_hz), int(round(duration_s * sample_rate_hz)) + 1,
+                     sample_rate_hz)
+    fdm.set_dt(frames.dt)
     fdm["simulation/models/FGFCS/enabled"] = 0
     if turbulence is not None:
         start_turbulence(fdm, turbulence, turbulence_seed)
     delays = [e for e in aircraft.hidden if e.effect == "control_delay"]
     if delays and loop.kind == "closed":
         raise ValueError("a hidden control delay is flown open loop only")
-
-    t_frames = np.arange(n_frames + 1) * dt
-    commands = {s: np.asarray(v, dtype=float) for s, v in deflections(t_frames).items()}
+    commands = {s: np.asarray(v, dtype=float) for s, v in deflections(frames.times).items()}
     trim_pos = {"de": trim_point.de_rad, "da": trim_point.da_rad, "dr": trim_point.dr_rad}
     unknown = set(commands) - set(trim_pos)
     if unknown:
         raise ValueError(f"unknown surfaces {sorted(unknown)}; the aircraft has de, da, dr")
-    props = aircraft.surfaces
     gain = loop.pitch_rate_gain if loop.kind == "closed" else 0.0
-    de_prop = props["de"]
-    de_cmd = (trim_pos["de"] + commands.get("de", np.zeros(n_frames + 1))).tolist()
-    # Property nodes are read and written without parsing a path each time.
-    pm = fdm.get_property_manager()
-    node = pm.get_node
-    # Surface writes only where a value changes: {frame: [(setter, value), ...]}.
-    changes: dict[int, list[tuple[Callable[[float], None], float]]] = {}
-    for s, cmd in commands.items():
-        if gain and s == "de":
-            continue  # written every frame with the feedback below
-        values = trim_pos[s] + cmd
-        setter = node(props[s]).set_double_value
+    props = aircraft.surfaces
+    node = fdm.get_property_manager().get_node  # property nodes: no path parsed per access
+    changes = _frame_writes(node, props, frames, trim_pos, commands, gain, wind_ned_fps, delays)
+    de_cmd = (trim_pos["de"] + commands.get("de", np.zeros(frames.n_frames + 1))).tolist()
+    read_props = ([p for _, p in _STATE_CHANNELS] + [props["de"], props["da"], props["dr"]]
+                  + list(_FORCES) + list(_AERO) + ["aero/alphadot-rad_sec"])
+    out = _run_frames(fdm, node, frames, changes, read_props, node(props["de"]).set_double_value,
+                      de_cmd, gain, _envelope_check(trim_point, loop, alpha_limit_rad, sample_rate_hz))
+    return _history(out, fdm, aircraft, trim_point, frames, loop)
+
+
+@dataclass(frozen=True)
+class _Frames:
+    """The simulation frames of a flight: ``n_sub`` frames of ``dt`` per sample, ``n_samples``."""
+
+    n_sub: int
+    dt: float
+    n_samples: int
+    sample_rate_hz: float
+
+    @property
+    def n_frames(self) -> int:
+        return (self.n_samples - 1) * self.n_sub
+
+    @property
+    def times(self) -> np.ndarray:
+        return np.arange(self.n_frames + 1) * self.dt
+
+
+_Writes = dict[int, list[tuple[Callable[[float], None], float]]]
+
+
+def _frame_writes(node, props: Mapping[str, str], frames: _Frames, trim_pos: dict[str, float],
+                  commands: dict[str, np.ndarray], gain: float, wind_ned_fps: Mapping[str, np.ndarray] | None,
+                  delays: list) -> _Writes:
+    """Every property write of the flight before its frame, ``{frame: [(setter, value), ...]}``,
+    only where a value changes (the first values are written now): the surfaces (the stabilator
+    is written every frame with the feedback when the loop is closed), a given wind, and the
+    delayed surfaces a hidden control delay feeds the aerodynamics."""
+    n_frames = frames.n_frames
+    changes: _Writes = {}
+
+    def write(setter: Callable[[float], None], values: np.ndarray, every_frame: bool = False) -> None:
         setter(float(values[0]))
-        for f in (np.flatnonzero(np.diff(values)) + 1).tolist():
+        where = range(1, n_frames + 1) if every_frame else (np.flatnonzero(np.diff(values)) + 1).tolist()
+        for f in where:
             changes.setdefault(f, []).append((setter, float(values[f])))
+
+    for s, cmd in commands.items():
+        if not (gain and s == "de"):
+            write(node(props[s]).set_double_value, trim_pos[s] + cmd)
     if wind_ned_fps:
-        t_samples = np.arange(n_samples) / sample_rate_hz
+        t_samples = np.arange(frames.n_samples) / frames.sample_rate_hz
         for axis, series in wind_ned_fps.items():
-            values = np.interp(t_frames, t_samples[:len(series)], np.asarray(series, dtype=float)[:n_samples])
-            setter = node(f"atmosphere/wind-{axis}-fps").set_double_value
-            setter(float(values[0]))
-            for f in range(1, n_frames + 1):
-                changes.setdefault(f, []).append((setter, float(values[f])))
+            values = np.interp(frames.times, t_samples[:len(series)],
+                               np.asarray(series, dtype=float)[:frames.n_samples])
+            write(node(f"atmosphere/wind-{axis}-fps").set_double_value, values, every_frame=True)
     for e in delays:
         # the aerodynamics see the surface late: drive its delay property with δ(t − τ) − δ(t)
         values = trim_pos[e.surface] + commands.get(e.surface, np.zeros(n_frames + 1))
-        delta = delay_deltas(values, frames_of(e.size, dt))
-        setter = node(delay_property(e.surface)).set_double_value
-        setter(float(delta[0]))
-        for f in (np.flatnonzero(np.diff(delta)) + 1).tolist():
-            changes.setdefault(f, []).append((setter, float(delta[f])))
+        write(node(delay_property(e.surface)).set_double_value, delay_deltas(values, frames_of(e.size, frames.dt)))
+    return changes
 
-    read_props = ([p for _, p in _STATE_CHANNELS] + [props["de"], props["da"], props["dr"]]
-                  + list(_FORCES) + list(_AERO) + ["aero/alphadot-rad_sec"])
-    i_alpha = 1
-    i_beta = 2
-    rows: list[list[float]] = []
+
+def _envelope_check(trim_point: TrimPoint, loop: Loop, alpha_limit_rad: float,
+                    sample_rate_hz: float) -> Callable[[list[float], int], None]:
+    """``check(row, k)``: a FlightError when sample ``k`` (V, α, β first) leaves the envelope."""
+    def check(row: list[float], k: int) -> None:
+        a, b, v = row[1], row[2], row[0]
+        # NaN fails every comparison, so "not (x < limit)" also catches it.
+        if not (abs(a) < alpha_limit_rad and abs(b) < alpha_limit_rad and v > 0.5 * trim_point.V_fps):
+            raise FlightError(
+                f"simulation diverged at t = {k / sample_rate_hz:.2f} s ({loop.describe()}): alpha = "
+                f"{math.degrees(a):.1f} deg, beta = {math.degrees(b):.1f} deg, V = {v:.0f} ft/s (limits: |alpha|, "
+                f"|beta| < {math.degrees(alpha_limit_rad):.0f} deg, V > {0.5 * trim_point.V_fps:.0f} ft/s); "
+                "the aircraft is unstable for this loop or the input is too large")
+    return check
+
+
+def _run_frames(fdm: jsbsim.FGFDMExec, node, frames: _Frames, changes: _Writes, read_props: list[str],
+                set_de: Callable[[float], None], de_cmd: list[float], gain: float,
+                check: Callable[[list[float], int], None]) -> np.ndarray:
+    """Step the frames, writing what changes before each and the stabilator with the pitch-rate
+    feedback when ``gain``; read ``read_props`` on every sample time. Samples x properties."""
     getters = [node(p).get_double_value for p in read_props]
+    rows: list[list[float]] = []
 
     def sample() -> None:
         row = [g() for g in getters]
         rows.append(row)
-        a, b, v = row[i_alpha], row[i_beta], row[0]
-        # NaN fails every comparison, so "not (x < limit)" also catches it.
-        if not (abs(a) < alpha_limit_rad and abs(b) < alpha_limit_rad and v > 0.5 * trim_point.V_fps):
-            t = (len(rows) - 1) / sample_rate_hz
-            raise FlightError(
-                f"simulation diverged at t = {t:.2f} s ({loop.describe()}): alpha = {math.degrees(a):.1f} deg, "
-                f"beta = {math.degrees(b):.1f} deg, V = {v:.0f} ft/s (limits: |alpha|, |beta| < "
-                f"{math.degrees(alpha_limit_rad):.0f} deg, V > {0.5 * trim_point.V_fps:.0f} ft/s); "
-                "the aircraft is unstable for this loop or the input is too large")
+        check(row, len(rows) - 1)
 
     sample()
     run = fdm.run
-    set_de = node(de_prop).set_double_value
     get_q = node("velocities/q-rad_sec").get_double_value
     f = 0
-    for _ in range(n_samples - 1):
-        for _ in range(n_sub):
+    for _ in range(frames.n_samples - 1):
+        for _ in range(frames.n_sub):
             f += 1
             if f in changes:
                 for setter, v in changes[f]:
@@ -222,16 +257,23 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
                 set_de(de_cmd[f] + gain * get_q())
             run()
         sample()
-
     out = np.asarray(rows, dtype=float)
     bad = ~np.isfinite(out)
     if bad.any():
         k, col = np.argwhere(bad)[0]
-        raise FlightError(f"simulation produced a non-finite {read_props[col]} at t = {k / sample_rate_hz:.2f} s")
+        raise FlightError(f"simulation produced a non-finite {read_props[col]} at t = {k / frames.sample_rate_hz:.2f} s")
+    return out
+
+
+def _history(out: np.ndarray, fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint, frames: _Frames,
+             loop: Loop) -> FlightHistory:
+    """The sampled properties as channels (states, surfaces, accelerations in g, the sensor
+    effects of hidden physics applied) and the truth coefficients (Eqs. 1-5 and Eq. 2)."""
+    sample_rate_hz = frames.sample_rate_hz
     state_cols = [c for c, _ in _STATE_CHANNELS]
     surf_cols = ["de_rad", "da_rad", "dr_rad"]
     mass = fdm["inertia/mass-slugs"]
-    channels = {"t_s": np.arange(n_samples) / sample_rate_hz}
+    channels = {"t_s": np.arange(frames.n_samples) / sample_rate_hz}
     for i, col in enumerate(state_cols):
         channels[col] = out[:, i]
     # JSBSim's heading lies in [0, 2*pi): a yaw through north would jump by 2*pi. Recorded
@@ -254,4 +296,4 @@ def fly(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, trim_point: TrimPoint,
         "alphadot": out[:, j + 12],
     }
     return FlightHistory(channels=channels, truth=truth, sample_rate_hz=sample_rate_hz,
-                         sim_rate_hz=n_sub * sample_rate_hz, frames=n_frames, loop=loop)
+                         sim_rate_hz=frames.n_sub * sample_rate_hz, frames=frames.n_frames, loop=loop)
