@@ -324,20 +324,7 @@ def _list(d: dict, key: str, default: list, where: str) -> list:
 
 def load_campaign(path: str | Path) -> Campaign:
     """Parse a campaign TOML file (a path, or the name of a built-in campaign)."""
-    p = Path(path)
-    if not p.suffix and not p.exists():
-        p = BUILTIN_DIR / f"{path}.toml"
-    if not p.is_file():
-        names = sorted(x.stem for x in BUILTIN_DIR.glob("*.toml"))
-        raise CampaignError(f"no campaign file {path!s} (built-in campaigns: {', '.join(names)})")
-    try:
-        text = p.read_bytes().decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise CampaignError(f"{p}: not valid UTF-8 (byte {exc.start}); save the file as UTF-8") from None
-    try:
-        d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignError(f"{p}: not valid TOML: {exc}") from None
+    p, text, d = _read_campaign_file(path)
     where = str(p)
     for key in ("name", "seed", "realizations", "grid"):
         if key not in d:
@@ -354,16 +341,50 @@ def load_campaign(path: str | Path) -> Campaign:
     truth = d.get("truth", "local")
     if truth not in ("local", "fit"):
         raise CampaignError(f"{where}: truth must be 'local' or 'fit', not {truth!r}")
-
-    mdefs = {}
-    for mname, spec in _known_keys(d.get("maneuvers", {}), tuple(d.get("maneuvers", {})), "maneuvers",
-                                   where).items():
-        mdefs[mname] = _maneuver_def(mname, spec, where)
+    mdefs = {mname: _maneuver_def(mname, spec, where) for mname, spec in
+             _known_keys(d.get("maneuvers", {}), tuple(d.get("maneuvers", {})), "maneuvers", where).items()}
     maneuvers = [mdefs.get(m) or ManeuverDef(m, m) for m in _list(grid, "maneuver", ["2-1-1-2"], where)]
+    noises = _noises(d, grid, where)
+    flights = _flights(d, grid, flight_defaults, mdefs, maneuvers, where)
+    combine = bool(d.get("combine", False))
+    methods = _methods(grid, combine, flights, where)
+    errors = tuple(_list(grid, "errors", ["conventional"], where))
+    for e in errors:
+        if e not in ("conventional", "colored"):
+            raise CampaignError(f"{where}: grid.errors {e!r} must be 'conventional' or 'colored'")
+    try:
+        equations = tuple(parse_equation(e) for e in _list(grid, "equations", ["Cm = alpha + qhat + de"], where))
+    except ValueError as exc:
+        raise CampaignError(f"{where}: {exc}") from None
+    return Campaign(name=name, description=description, seed=seed,
+                    realizations=realizations, truth=truth, flights=flights, noises=noises,
+                    methods=methods, errors=errors, equations=equations, path=str(p),
+                    text_hash=hashlib.sha256(text.encode()).hexdigest(), extra=d.get("report", {}),
+                    method_options=_method_options(d, where), combine=combine,
+                    method_factories=_method_factories(d, methods, where))
 
-    ndefs = {}
-    for nname, spec in d.get("noise", {}).items():
-        ndefs[nname] = _noise_def(nname, spec, where)
+
+def _read_campaign_file(path: str | Path) -> tuple[Path, str, dict]:
+    """The file (a path, or a built-in campaign's name), its text and its TOML tables."""
+    p = Path(path)
+    if not p.suffix and not p.exists():
+        p = BUILTIN_DIR / f"{path}.toml"
+    if not p.is_file():
+        names = sorted(x.stem for x in BUILTIN_DIR.glob("*.toml"))
+        raise CampaignError(f"no campaign file {path!s} (built-in campaigns: {', '.join(names)})")
+    try:
+        text = p.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise CampaignError(f"{p}: not valid UTF-8 (byte {exc.start}); save the file as UTF-8") from None
+    try:
+        return p, text, tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CampaignError(f"{p}: not valid TOML: {exc}") from None
+
+
+def _noises(d: dict, grid: dict, where: str) -> tuple[NoiseDef, ...]:
+    """``grid.noise``: each a ``[noise.NAME]`` table of the file or a preset."""
+    ndefs = {nname: _noise_def(nname, spec, where) for nname, spec in d.get("noise", {}).items()}
     noises = []
     for n in _list(grid, "noise", ["none"], where):
         if n in ndefs:
@@ -372,7 +393,12 @@ def load_campaign(path: str | Path) -> Campaign:
             noises.append(NoiseDef(n, n))
         else:
             raise CampaignError(f"{where}: grid.noise {n!r} is neither a preset {PRESETS} nor a [noise.{n}] table")
+    return tuple(noises)
 
+
+def _flights(d: dict, grid: dict, flight_defaults: dict, mdefs: dict, maneuvers: list, where: str
+             ) -> tuple[FlightKey, ...]:
+    """The flights: the file's ``[[flights]]`` list, or the product of the grid's flight axes."""
     duration = flight_defaults.get("duration_s")
     if duration is not None:
         duration = _number(duration, "flight.duration_s", where, positive=True)
@@ -405,7 +431,11 @@ def load_campaign(path: str | Path) -> Campaign:
             _check_flight_axes(f.aircraft, f.variant, f.condition, f.loop, "grid.", where)
     for f in flights:
         _check_maneuver_kind(f.maneuver, where)
-    combine = bool(d.get("combine", False))
+    return flights
+
+
+def _methods(grid: dict, combine: bool, flights: tuple[FlightKey, ...], where: str) -> tuple[str, ...]:
+    """``grid.method``: methods of the registry, multiple-maneuver ones in a combined campaign."""
     allowed = COMBINED_METHODS if combine else METHODS
     methods = tuple(_list(grid, "method", ["ee-concat" if combine else "ee-time"], where))
     for m in methods:
@@ -414,14 +444,11 @@ def load_campaign(path: str | Path) -> Campaign:
                                 + (" (a combined campaign)" if combine else ""))
     if combine and len(flights) < 2:
         raise CampaignError(f"{where}: combine = true needs at least two flights")
-    errors = tuple(_list(grid, "errors", ["conventional"], where))
-    for e in errors:
-        if e not in ("conventional", "colored"):
-            raise CampaignError(f"{where}: grid.errors {e!r} must be 'conventional' or 'colored'")
-    try:
-        equations = tuple(parse_equation(e) for e in _list(grid, "equations", ["Cm = alpha + qhat + de"], where))
-    except ValueError as exc:
-        raise CampaignError(f"{where}: {exc}") from None
+    return methods
+
+
+def _method_options(d: dict, where: str) -> tuple[tuple[str, tuple], ...]:
+    """``[method_options.METHOD]``: frequencies, detrend and max_lag of a method."""
     method_options = []
     if not isinstance(d.get("method_options", {}), dict):
         raise CampaignError(f"{where}: method_options must be a table of [method_options.METHOD] tables")
@@ -436,12 +463,7 @@ def load_campaign(path: str | Path) -> Campaign:
                                 "(frequencies, detrend, max_lag)")
         _check_method_options(m, opts, where)
         method_options.append((m, tuple(sorted(opts.items()))))
-    return Campaign(name=name, description=description, seed=seed,
-                    realizations=realizations, truth=truth, flights=flights, noises=tuple(noises),
-                    methods=methods, errors=errors, equations=equations, path=str(p),
-                    text_hash=hashlib.sha256(text.encode()).hexdigest(), extra=d.get("report", {}),
-                    method_options=tuple(method_options), combine=combine,
-                    method_factories=_method_factories(d, methods, where))
+    return tuple(method_options)
 
 
 def _maneuver_def(name: str, spec: object, file: str) -> ManeuverDef:
