@@ -65,15 +65,7 @@ class _DefaultsFormatter(argparse.HelpFormatter):
         return f"{text} (default: {shown})".strip()
 
 
-def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="sidbench",
-        description="Validation harness for aircraft parameter estimation: JSBSim flies the "
-                    "maneuvers, estimators recover known coefficients, the harness scores them.")
-    p.add_argument("--debug", action="store_true",
-                   help="show the traceback of user errors too (one line and exit status 2 without it)")
-    sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
-
+def _add_fly(sub) -> None:
     f = sub.add_parser("fly", help="trim an aircraft, fly a maneuver and write the recording",
                        description="Trim, fly one maneuver open or closed loop, and write the "
                                    "recording (CSV + .meta.json, or Parquet) with its truth.")
@@ -82,6 +74,8 @@ def _parser() -> argparse.ArgumentParser:
     f.add_argument("--out", required=True, help="output recording: NAME.csv (+ NAME.meta.json) or NAME.parquet")
     f.set_defaults(func=lambda a: _commands().cmd_fly(a))
 
+
+def _add_truth(sub) -> None:
     t = sub.add_parser("truth", help="truth derivatives of an aircraft at a flight condition",
                        description="Non-dimensional stability and control derivatives at trim, about "
                                    "the c.g., per rad (rates normalised by cbar/2V and b/2V), by central "
@@ -97,6 +91,8 @@ def _parser() -> argparse.ArgumentParser:
                         "(default: off)")
     t.set_defaults(func=lambda a: _commands().cmd_truth(a))
 
+
+def _add_import(sub) -> None:
     i = sub.add_parser("import", help="convert a SIDPAC .mat file, or a user's ASCII/CSV file with a column map, "
                                       "to the canonical recording format",
                        description="Import a SIDPAC flight-test file (t, fdata, fds) into the canonical "
@@ -112,6 +108,8 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--out", required=True, help="output recording (.csv or .parquet)")
     i.set_defaults(func=lambda a: _commands().cmd_import(a))
 
+
+def _add_estimate(sub) -> None:
     e = sub.add_parser("estimate", help="estimate model parameters from a recording",
                        description="Fit one equation (dependent = sum of regressors + bias) by equation "
                                    "error in the time domain (ee-time), with smoothed regressors "
@@ -162,6 +160,8 @@ def _parser() -> argparse.ArgumentParser:
                         "regressors, estimates with bounds and truth (default: none)")
     e.set_defaults(func=lambda a: _commands().cmd_estimate(a))
 
+
+def _add_campaign(sub) -> None:
     c = sub.add_parser("campaign", help="run a Monte Carlo campaign and print its scores",
                        description="Run a campaign file (TOML; or the name of a built-in campaign: "
                                    "regressor-noise, error-bounds, collinearity, multiple-maneuvers, "
@@ -179,11 +179,15 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--quiet", action="store_true", help="no progress display")
     c.set_defaults(func=lambda a: _commands().cmd_campaign(a))
 
+
+def _add_bench(sub) -> None:
     b = sub.add_parser("bench", help="measure and print the benchmark table",
                        description="Time the project's main operations on this machine and print them.")
     b.add_argument("--repeat", type=int, default=7, help="repetitions per row (the best is kept)")
     b.set_defaults(func=lambda a: _bench().cmd_bench(a))
 
+
+def _add_demo(sub) -> None:
     d = sub.add_parser("demo", help="the main job: fly, print the truth, run a quick campaign, write a report",
                        description="Fly the seed's default maneuver (F-16, stabilator 2-1-1-2, 1 deg, 1 s "
                                    "unit pulse), print its truth table, run a quick regressor-noise campaign and "
@@ -193,6 +197,8 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     d.set_defaults(func=lambda a: _report_commands().cmd_demo(a))
 
+
+def _add_diagnose(sub) -> None:
     g = sub.add_parser("diagnose", help="locate and name what a model leaves out of a recording, model it, "
                                         "show the fit improve",
                        description="Compare a model with a recording (canonical format): replay the recorded "
@@ -209,6 +215,8 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--out", required=True, help="output folder")
     g.set_defaults(func=lambda a: _commands().cmd_diagnose(a))
 
+
+def _add_calibrate(sub) -> None:
     cal = sub.add_parser("calibrate", help="JSBSim in the loop: calibrate an aircraft XML to flight recordings by "
                                            "output error",
                          description="Fly the JSBSim aircraft with the recorded surfaces from each recording's start "
@@ -243,6 +251,8 @@ def _parser() -> argparse.ArgumentParser:
     cal.add_argument("--max-iterations", type=int, default=20, help="Gauss-Newton iterations at most (default 20)")
     cal.set_defaults(func=_calibrate)
 
+
+def _add_gallery(sub) -> None:
     gg = sub.add_parser("gallery", help="write the concealed-effect recordings (identification + validation)",
                         description="Fly the F-16 with one hidden effect per case, add the realistic noise layer "
                                     "and write OUT/<case>-identification.csv, -validation.csv and the answer.")
@@ -251,6 +261,8 @@ def _parser() -> argparse.ArgumentParser:
     gg.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
     gg.set_defaults(func=lambda a: _diagnosis_commands().cmd_gallery(a))
 
+
+def _add_diagnosis_sweep(sub) -> None:
     sw = sub.add_parser("diagnosis-sweep", help="score the diagnosis on concealed effects of every id, sizes and "
                                                 "maneuvers against the outside bar",
                         description="Fly about seventy F-16 recordings with one concealed effect each (every id of "
@@ -263,6 +275,8 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     sw.set_defaults(func=lambda a: _diagnosis_commands().cmd_sweep(a))
 
+
+def _add_outside_sweep(sub) -> None:
     so = sub.add_parser("outside-sweep", help="score the diagnosis on flight-test-like recordings at other conditions "
                                               "and on a second aircraft (c172x)",
                         description="Fly about eighty recordings the way a flight-test team's data arrive (surfaces "
@@ -278,6 +292,8 @@ def _parser() -> argparse.ArgumentParser:
     so.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     so.set_defaults(func=lambda a: _diagnosis_commands().cmd_outside_sweep(a))
 
+
+def _add_report(sub) -> None:
     r = sub.add_parser("report", help="turn campaign output into HTML, Markdown and JSON reports",
                        description="Write report.html (self-contained), report.md and report.json for a campaign "
                                    "output folder; --kind benchmark ranks the methods over one or more folders.")
@@ -287,6 +303,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--out", default=None, help="where to write (default: the first folder)")
     r.set_defaults(func=lambda a: _report_commands().cmd_report(a))
 
+
+def _add_nightly(sub) -> None:
     n = sub.add_parser("nightly", help="run the nightly campaign, compare, gate, report",
                        description="Run the nightly campaign, append it to the history, compare it with the previous "
                                    "run and the declared gates, and write nightly.html/.md/.json. Exits 1 when a gate "
@@ -307,6 +325,8 @@ def _parser() -> argparse.ArgumentParser:
     n.add_argument("--quiet", action="store_true", help="no progress display")
     n.set_defaults(func=lambda a: _report_commands().cmd_nightly(a))
 
+
+def _add_review_maneuvers(sub) -> None:
     v = sub.add_parser("review-maneuvers", help="maneuver design review of candidate inputs",
                        description="Fly candidate inputs on an aircraft and condition, score them by Monte Carlo, "
                                    "and write review.html: input spectra against the modes, predicted Cramér-Rao "
@@ -330,6 +350,21 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--cache", default=None, help="flight cache folder (default .sidbench-cache)")
     v.add_argument("--quiet", action="store_true", help="no progress display")
     v.set_defaults(func=lambda a: _report_commands().cmd_review_maneuvers(a))
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The command line: the global options, then each subcommand's parser (``_add_<name>``)."""
+    p = argparse.ArgumentParser(
+        prog="sidbench",
+        description="Validation harness for aircraft parameter estimation: JSBSim flies the "
+                    "maneuvers, estimators recover known coefficients, the harness scores them.")
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of user errors too (one line and exit status 2 without it)")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for add in (_add_fly, _add_truth, _add_import, _add_estimate, _add_campaign, _add_bench, _add_demo,
+                _add_diagnose, _add_calibrate, _add_gallery, _add_diagnosis_sweep, _add_outside_sweep, _add_report,
+                _add_nightly, _add_review_maneuvers):
+        add(sub)
     for command in sub.choices.values():
         command.formatter_class = _DefaultsFormatter
     p.formatter_class = _DefaultsFormatter
