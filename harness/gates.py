@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from scipy.stats import norm
+
 from models.errors import UserError
 
 DEFAULT_GATES = Path(__file__).resolve().parent / "nightly-gates.toml"

@@ -23,8 +23,9 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
-from models.errors import UserError
+
 from models.constants import SURFACES
+from models.errors import UserError
 
 # SURFACES (models.constants): valid surface names, in pitch, roll, yaw order.
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import jsbsim
+
 from models.errors import OptionError
 
 # JSBSim's turb-type codes: the header comments say 4/5, the code uses 3/4 (../shared/jsbsim-notes.md).

@@ -10,10 +10,10 @@ import numpy as np
 
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence, start_turbulence
+from models.axes import wind_axis_coefficients
+from models.constants import G0_FPS2
 from models.hidden import apply_sensor_effects, delay_deltas, delay_property, frames_of
 from models.trim import TrimPoint
-from models.constants import G0_FPS2
-from models.axes import wind_axis_coefficients
 
 Deflections = Callable[[np.ndarray], Mapping[str, np.ndarray]]
 

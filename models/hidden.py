@@ -33,6 +33,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
+
 from models.constants import BODY_COEFFICIENTS as COEFFICIENTS, G0_FPS2, SURFACES
 
 AERO_TERMS = ("unsteady_alphadot", "nonlinear_alpha", "coefficient_error", "cross_coupling",
