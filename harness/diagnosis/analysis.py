@@ -8,6 +8,7 @@ import numpy as np
 
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import rivals
+from estimators.colored_stepwise import colored_fit
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
                                           is_plausible, is_practical, kinematic_check, kinematic_residuals)
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
@@ -221,6 +222,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                          for c in COEFFICIENTS}
         return slopes[x]
 
+    _withhold_explained_by_cg(cands, selections, mismatch, p)
     _withhold_rivals(cands, selections, nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
     _withhold_ambiguous(cands, kin)
     if turbulent:
@@ -250,6 +252,35 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
     (recording-format.md), the metadata's trim thrust when given, else the model's."""
     given = (p.meta.get("trim") or {}).get("thrust_lbf")
     return float(given) if given is not None else float(model_trim_thrust_lbf)
+
+
+def _withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
+                              p: Prepared) -> None:
+    """A moment-reference shift is one parameter acting on two axes (C_m through C_Z, C_n
+    through C_Y). Once named on one, its share of the other axis's mismatch is known; a term
+    selected on that other axis is kept only if it stays significant (|t| >= the entry t)
+    with that share removed (a 1.5 ft shift otherwise reads as a C_n,β change too)."""
+    cg = next((c for c in cands if c.selected and c.effect == "cg_offset"), None)
+    if cg is None:
+        return
+    inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
+    for axis, (sel, by_key) in selections.items():
+        if axis == cg.channel or "cg" not in by_key:
+            continue
+        z = mismatch[axis][inner] - cg.estimate / by_key["cg"].scale * by_key["cg"].column[inner]
+        chosen = [k for k in sel.names if k in by_key and k != "cg"]
+        for c in cands:
+            key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
+            if not c.selected or c.channel != axis or key is None:
+                continue
+            others = [by_key[k].column[inner] for k in chosen if k != key]
+            theta, se, _ = colored_fit(z, others + [by_key[key].column[inner]], [f"o{i}" for i in range(len(others))]
+                                       + [key])
+            t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
+            if abs(t) < cand.T_IN:
+                c.selected = False
+                c.reason = (f"entered, but explained by the moment-reference shift named on {cg.channel} "
+                            f"({cg.estimate:.3g} ft): with its share of the {axis} mismatch removed, t = {t:.1f}")
 
 
 def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:
@@ -337,6 +368,9 @@ APPLY_T = 3.0
 # model's nonlinearity).
 AMBIGUOUS_T = 2.5
 AMBIGUOUS_KINDS = ("scale", "skew", "vane")
+# The instrument each coefficient is measured with (seed Eqs. 1, 3-5): a skew of it imitates
+# an α̇ or rate term of that coefficient (the coefficient lags by the skew), a scale every term.
+DEPENDENT_SENSOR = {"CX": "ax", "CY": "ay", "CZ": "az", "Cl": "p", "Cm": "q", "Cn": "r"}
 
 
 NOT_IN_GUSTS = ("not named: in turbulence the aerodynamics see air-relative rates (the gust's rotational part, "
@@ -410,6 +444,16 @@ def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
             c.selected = False
             c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({rival}, "
                         f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
+    for c in cands:  # the sensor the coefficient itself is measured with
+        sensor = DEPENDENT_SENSOR.get(c.channel or "")
+        if not (c.selected and sensor in suspects and c.test.startswith("stepwise")):
+            continue
+        rival, t = suspects[sensor]
+        if rival.startswith("skew") and c.effect not in ("unsteady_alphadot", "coefficient_error"):
+            continue
+        c.selected = False
+        c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
+                    f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
 KINEMATIC_PASSES = 4
 
 
