@@ -1,7 +1,7 @@
 """The diagnosis refined, on the concealed-effect gallery: for each case, the diagnosis's
 added terms at their equation-error sizes (``calibrate``'s start, ``--parameters auto``) against
 the same terms calibrated in the loop; the validation RMS error of every output, before
-(equation-error sizes) and after. ``python -m harness.calibrate.gallery OUT [CASE ...]``
+(equation-error sizes) and after. ``python -m harness.calibrate.gallery OUT [--seed N] [CASE ...]``
 writes OUT/gallery-calibration.json and prints a Markdown table."""
 from __future__ import annotations
 
@@ -54,9 +54,14 @@ def table(rows: list[dict]) -> str:
 
 
 def main(argv: list[str]) -> int:
+    seed = 1
+    if "--seed" in argv:
+        i = argv.index("--seed")
+        seed = int(argv[i + 1])
+        argv = argv[:i] + argv[i + 2:]
     out = Path(argv[0])
     names = argv[1:] or [c.name for c in CASES]
-    rows = [refine_case(n, out) for n in names]
+    rows = [refine_case(n, out, seed=seed) for n in names]
     write_text_atomic(out / "gallery-calibration.json", json.dumps(rows, indent=1, default=float))
     print(table(rows))
     return 0
