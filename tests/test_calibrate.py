@@ -217,3 +217,20 @@ def test_coloured_middle_matrix_equals_its_definition():
             T = np.array([[c[i - j] for j in range(n)] for i in range(n)])
             want += X[:, :, o] @ T @ X[:, :, o2].T
     assert np.allclose(colored_middle([S], [v], R), want, rtol=1e-10, atol=1e-10)
+
+
+SIDPAC = Path(__file__).resolve().parents[2] / "shared" / "data" / "sidpac"
+
+
+@pytest.mark.skipif(not (SIDPAC / "totter_f1_017_data.mat").is_file(), reason="../shared flight data not present")
+def test_twin_otter_directional_stability_cut_and_the_validation_flight_followed():
+    """Must-show 4 in brief: the DHC6's C_n,β and C_l,β tables scaled on flight 017 (its mass),
+    validated on 014: C_n,β comes down to about a fifth, and the β and r errors of the
+    validation flight fall by more than half."""
+    r = calibrate("dhc6", SIDPAC / "totter_f1_017_data.mat",
+                  "aero/coefficient/Cnb:scale,aero/coefficient/Clb:scale",
+                  validation=SIDPAC / "totter_f1_014_data.mat", mass="recording", workers=2, max_iterations=10)
+    scale = dict(zip((a.name for a in r.adjustments), r.estimate))
+    assert 0.15 < scale["aero/coefficient/Cnb:scale"] < 0.3
+    for c in ("beta", "r"):
+        assert r.fit_after["validation"][c]["rms"] < 0.5 * r.fit_before["validation"][c]["rms"]
