@@ -179,8 +179,10 @@ def fly(job: Flight) -> np.ndarray | str:
             write_root(Path(folder), name, tree, Path(b.source))
             hist, _ = replay(aircraft, m.ic, m.t, m.surfaces, root=Path(folder), name=name,
                              delays_s=delays(job.adjustments, job.values), hold=m.hold)
-    except (FlightError, TrimError) as exc:
-        return str(exc)
+    except (FlightError, TrimError, RuntimeError, ValueError) as exc:
+        # a trim without equilibrium, a divergence, an XML JSBSim will not load at these values:
+        # the reason goes back to the fit, which halves its step (never a crash in a worker)
+        return f"{type(exc).__name__}: {exc}"
     n = len(m.t)
     cols = [hist.channels[f"{o}_{UNITS[o]}"] for o in m.outputs]
     y = np.column_stack(cols)
