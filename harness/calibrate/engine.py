@@ -90,14 +90,14 @@ def sensitivities(y0: list[np.ndarray], ys: list[list[np.ndarray | str]], h: np.
 
 
 def backward(S: list[np.ndarray], y0: list[np.ndarray], ys: list[list[np.ndarray | str]], h: np.ndarray,
-             failed: list[int]) -> list[str]:
+             failed: list[int], labels: list[str]) -> list[str]:
     """Fill the columns of ``failed`` by backward differences [y(θ) − y(θ − h_j e_j)]/h_j from
     the flights ``ys`` (one per failed parameter), in place; notes on any that failed too."""
     notes = []
-    for j, per in zip(failed, ys):
+    for j, label, per in zip(failed, labels, ys):
         for m, y in enumerate(per):
             if isinstance(y, str):
-                notes.append(f"parameter {j}: the flights at θ ± h both failed on maneuver {m} ({y}); its "
+                notes.append(f"{label}: the flights at θ ± h both failed on maneuver {m} ({y}); its "
                              "sensitivity there is taken as zero")
             else:
                 S[m][j] = (y0[m] - y) / h[j]
@@ -192,6 +192,9 @@ def gauss_newton(evaluate: Evaluate, theta0: np.ndarray, typical: np.ndarray, lo
 
     notes: list[str] = []
 
+    def label(j: int) -> str:
+        return names[j] if j < len(names) else f"parameter {j}"
+
     def differences(th: np.ndarray, y0: list[np.ndarray], ys, h: np.ndarray) -> list[np.ndarray]:
         S, failed = sensitivities(y0, ys, h)
         if failed:
@@ -200,8 +203,8 @@ def gauss_newton(evaluate: Evaluate, theta0: np.ndarray, typical: np.ndarray, lo
                 pt = th.copy()
                 pt[j] -= h[j]
                 back.append(pt)
-            notes.extend(f"parameter {j}: the flight at θ + h failed; backward difference" for j in failed)
-            notes.extend(backward(S, y0, batch(back), h, failed))
+            notes.extend(f"{label(j)}: the flight at θ + h failed; backward difference" for j in failed)
+            notes.extend(backward(S, y0, batch(back), h, failed, [label(j) for j in failed]))
         return S
 
     h = steps(theta, typical)
@@ -211,6 +214,10 @@ def gauss_newton(evaluate: Evaluate, theta0: np.ndarray, typical: np.ndarray, lo
     if bad:
         raise RuntimeError(f"the model cannot fly the recordings at the starting values ({'; '.join(bad)})")
     S = differences(theta, y, first[1:], h)
+    dead = [label(j) for j in range(p) if not any(np.any(Sm[j] != 0) for Sm in S)]
+    if dead:
+        raise RuntimeError(f"the recorded outputs do not depend on {', '.join(dead)} in these flights: not "
+                           "identifiable (is the surface or motion that drives it in the recording?)")
     b = np.array([np.mean(zm - ym, axis=0) for zm, ym in zip(z, y)])
     floor = NOISE_FLOOR * np.maximum(np.var(np.vstack(z), axis=0), 1e-300)
 

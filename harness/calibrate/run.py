@@ -220,7 +220,8 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
     with tempfile.TemporaryDirectory(prefix="sidbench-calibrate-") as scratch, make_executor(None, workers) as ex:
         evaluate = _evaluator(ex, base, adjustments, refs, ident, scratch)
         try:
-            res = gauss_newton(evaluate, start, typical, lower, [m.z for m in ident], max_iterations=max_iterations)
+            res = gauss_newton(evaluate, start, typical, lower, [m.z for m in ident], max_iterations=max_iterations,
+                               names=[a.name for a in adjustments])
         except RuntimeError as exc:
             raise CalibrationError(str(exc)) from exc
         final = _evaluator(ex, base, adjustments, refs, ident + valid, scratch)([start, res.theta])
