@@ -510,13 +510,16 @@ def _unconfirmed_table(data: Mapping) -> Table | None:
     rows = [{"effect": str(f.get("effect", "")), "parameter": _scalar(f.get("parameter")),
              "estimate": _num(f.get("estimate")), "std_error": _num(f.get("std_error")),
              "units": _scalar(f.get("units")),
-             "on validation": _dict(_dict(f.get("evidence")).get("validation")).get("status", "—")}
+             "on validation": _dict(_dict(f.get("evidence")).get("validation")).get("status", "—"),
+             "why": _scalar(_dict(_dict(f.get("evidence")).get("validation")).get("reason", ""))}
             for f in data.get("not_confirmed") or [] if isinstance(f, Mapping)]
     if not rows:
         return None
-    return Table("Not confirmed on the validation maneuver", pd.DataFrame(rows),
+    return Table("Not confirmed", pd.DataFrame(rows),
                  "Terms the identification maneuver called for but the validation maneuver did not confirm "
-                 "(neutral or contradicted): not findings, and left out of the augmented model.")
+                 "(neutral or contradicted), or could not tell from a rival that fits as well (ambiguous: a "
+                 "collinear candidate of the same axis, see the reason): not findings, and left out of the "
+                 "augmented model.")
 
 
 def _located_lines(located: Mapping) -> tuple[str, ...]:

@@ -369,7 +369,7 @@ APPLY_T = 3.0
 AMBIGUOUS_T = 2.5
 AMBIGUOUS_KINDS = ("scale", "skew", "vane")
 # The instrument each coefficient is measured with (seed Eqs. 1, 3-5): a skew of it imitates
-# an α̇ or rate term of that coefficient (the coefficient lags by the skew), a scale every term.
+# an α̇ or rate term of that coefficient (ΔC ≈ −τ dC/dt follows the rates), a scale every term.
 DEPENDENT_SENSOR = {"CX": "ax", "CY": "ay", "CZ": "az", "Cl": "p", "Cm": "q", "Cn": "r"}
 
 
@@ -449,8 +449,9 @@ def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
         if not (c.selected and sensor in suspects and c.test.startswith("stepwise")):
             continue
         rival, t = suspects[sensor]
-        if rival.startswith("skew") and c.effect not in ("unsteady_alphadot", "coefficient_error"):
-            continue
+        rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
+        if rival.startswith("skew") and not (c.effect == "unsteady_alphadot" or rate_term):
+            continue  # a lag imitates terms that follow the coefficient's rate of change, not its level
         c.selected = False
         c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
                     f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
