@@ -17,9 +17,6 @@ from models.aircraft import Aircraft, has_propeller
 from models.replay import AeroAlong, InitialCondition, aero_along
 from models.constants import G0_FPS2
 
-SENSOR_UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s",
-                "phi": "rad", "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
-
 
 @dataclass
 class Candidate:
@@ -79,127 +76,210 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     """Run every test on recording ``p`` against ``aircraft`` (module docstring)."""
     # 0. turbulence first: gusts make air-relative and inertial velocities differ, which
     # breaks the kinematic consistency the sensor tests rest on
-    gust = gust_estimate(kinematic_residuals(p.raw, p), p,
-                         0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * G0_FPS2)
-    turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
+    gust, turbulent = _turbulence(p)
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)
     V0 = float(np.mean(p.smooth["V"]))
-    # an estimate the data do not support (|t| < APPLY_T, e.g. a lateral bias on a pitch
-    # maneuver) says nothing about plausibility
-    plausible = all(is_plausible(n, kin.selection.params[n], V0) or _t_of(kin, n) < APPLY_T
-                    for n in kin.forced + kin.selection.names)
-    # an implausible estimate means the kinematics disagree for another reason: then no
-    # sensor correction is applied at all (they were estimated together)
-    # and only estimates the data support (|t| >= APPLY_T) correct the channels: a nuisance bias
-    # "below the entry t" may be a poorly determined 0.7 deg, and applying it would move the model
-    sensor_values = {} if turbulent or not plausible else {
-        n: kin.selection.params[n] for n in kin.forced + kin.selection.names if _t_of(kin, n) >= APPLY_T}
-    cands: list[Candidate] = []
-    # the forced biases are tested one by one, not picked as the best of many: the
-    # aerodynamic entry t serves, with the practical-size and precision rules
-    t_kin = cand.T_IN
-    for name in kin.forced:  # the nuisance biases: named when significant, practical and precise
+    plausible = _kinematics_plausible(kin, V0)
+    sensor_values = _sensor_values(kin, turbulent, plausible)
+    cands = _kinematic_candidates(kin, p, turbulent, plausible)
+    p = _corrected(p, kin, sensor_values)
+    # 2. the model along the measured states
+    states, surfaces = model_states(p)
+    alphadot = p.deriv["alpha"] if "alpha" in p.driven else None
+    aero = aero_along(aircraft, ic, states, surfaces, alphadot)
+    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
+    mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
+    noise = coefficient_noise(p, mismatch)
+    # 3. accelerometer position from the force mismatches (removed from them when named)
+    off, off_candidate = _offset_candidate(p, mismatch, noise, measured)
+    cands.append(off_candidate)
+    # 4. delay scans; 5. per-axis stepwise
+    delays = _delay_scans(p, mismatch, aero, noise)
+    step = _stepwise(p, has_propeller(aircraft.model), aero, measured, mismatch, delays)
+    cands += _aero_candidates(step.selections, delays, p.dt, step.shares)
+    # the rules that keep a term from being named when something else would imitate it
+    slope_of = _slope_function(aircraft, ic, states, surfaces, alphadot, aero)
+    _withhold_explained_by_cg(cands, step.selections, mismatch, p)
+    _withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
+    _withhold_ambiguous(cands, kin)
+    if turbulent:
+        _withhold_in_turbulence(cands)
+    # 6. spectra and gusts
+    peak = structural_peak(p)
+    cands += _spectral_candidates(peak, gust, turbulent)
+    return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
+                    selections=step.selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
+                    not_offered=step.not_offered)
+
+
+def _turbulence(p: Prepared):
+    """The gust estimate from the kinematic residual, and whether it says turbulence
+    (:data:`GUST_RATIO` times what sensor noise gives and at least :data:`GUST_MIN_FPS`)."""
+    gust = gust_estimate(kinematic_residuals(p.raw, p), p,
+                         0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * G0_FPS2)
+    turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
+    return gust, turbulent
+
+
+def _kinematics_plausible(kin: KinematicResult, V0: float) -> bool:
+    """Whether every kinematic estimate the data support (|t| >= :data:`APPLY_T`) is one an
+    instrument could have; an unsupported one (a lateral bias on a pitch maneuver) says
+    nothing about plausibility."""
+    return all(is_plausible(n, kin.selection.params[n], V0) or _t_of(kin, n) < APPLY_T
+               for n in kin.forced + kin.selection.names)
+
+
+def _sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool) -> dict[str, float]:
+    """The sensor corrections applied before the model is evaluated. None in turbulence or
+    when an estimate is implausible (the kinematics then disagree for another reason, and
+    the parameters were estimated together); else only those with |t| >= :data:`APPLY_T` (a
+    nuisance bias "below the entry t" may be a poorly determined 0.7 deg, and applying it
+    would move the model)."""
+    if turbulent or not plausible:
+        return {}
+    return {n: kin.selection.params[n] for n in kin.forced + kin.selection.names if _t_of(kin, n) >= APPLY_T}
+
+
+def _sensor_verdict(name: str, est: float, se: float, entered: bool, kin: KinematicResult, p: Prepared,
+                    turbulent: bool, plausible: bool) -> tuple[bool, str]:
+    """Whether a kinematic estimate is named, and why (or why not): it must have entered,
+    matter (practical size and share of its channel's excursion), be precise, and the
+    kinematics must hold (no turbulence, plausible estimates)."""
+    practical = is_practical(name, est, p.dt) and _kin_share(kin, name, est, p) >= cand.PRACTICAL_SHARE
+    precise = se <= max(0.5 * _practical_size(name, p.dt), 0.25 * abs(est))
+    sel = entered and practical and precise and not turbulent and plausible
+    reason = ("significant, practical and precise" if sel else "below the entry t" if not entered else
+              "within the instrument noise budget (practical size)" if not practical else
+              "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else IMPLAUSIBLE)
+    return sel, reason
+
+
+def _kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool) -> list[Candidate]:
+    """The sensor candidates. The forced (nuisance) biases are tested one by one, not picked
+    as the best of many: the aerodynamic entry t serves, with the practical-size and
+    precision rules; the selected terms by the kinematic selection's own entry."""
+    out = []
+    for name in kin.forced:
         sp = kin.parameters[name]
         est, se = kin.selection.params[name], kin.selection.std_errors[name]
         t = est / se if se > 0 else 0.0
-        practical = is_practical(name, est, p.dt) and _kin_share(kin, name, est, p) >= cand.PRACTICAL_SHARE
-        precise = se <= max(0.5 * _practical_size(name, p.dt), 0.25 * abs(est))
-        sel = abs(t) >= t_kin and practical and precise and not turbulent and plausible
-        reason = ("significant, practical and precise" if sel else "below the entry t" if abs(t) < t_kin else
-                  "within the instrument noise budget (practical size)" if not practical else
-                  "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else IMPLAUSIBLE)
-        cands.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
-                               "kinematic consistency (bias always fitted)", sel, reason))
+        sel, reason = _sensor_verdict(name, est, se, abs(t) >= cand.T_IN, kin, p, turbulent, plausible)
+        out.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
+                             "kinematic consistency (bias always fitted)", sel, reason))
     for term in kin.selection.terms:
         sp = kin.parameters[term.name]
-        practical = (is_practical(term.name, term.estimate, p.dt)
-                     and _kin_share(kin, term.name, term.estimate, p) >= cand.PRACTICAL_SHARE)
-        precise = term.std_error <= max(0.5 * _practical_size(term.name, p.dt), 0.25 * abs(term.estimate))
-        sel = term.selected and practical and precise and not turbulent and plausible
-        reason = ("significant, practical and precise" if sel else
-                  "below the entry t" if not term.selected else
-                  "within the instrument noise budget (practical size)" if not practical else
-                  "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else IMPLAUSIBLE)
-        cands.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
-                               sp.units, "kinematic consistency", sel, reason))
-    # correct the channels for everything the kinematics found (noise-budget biases too)
-    if sensor_values:
-        ch = corrected_channels(p.raw, p, kin.parameters, sensor_values)
-        smooth = {c: p.filt(x) for c, x in ch.items()}
-        deriv = {c: p.differentiate(x) for c, x in ch.items()}
-        k = max(1, int(round(0.5 / p.dt)))
-        start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
-        p = replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
-    # 2. the model along the measured states
+        sel, reason = _sensor_verdict(term.name, term.estimate, term.std_error, term.selected, kin, p, turbulent,
+                                      plausible)
+        out.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
+                             sp.units, "kinematic consistency", sel, reason))
+    return out
+
+
+def _corrected(p: Prepared, kin: KinematicResult, values: dict[str, float]) -> Prepared:
+    """The recording with its channels corrected for the sensor ``values`` (re-smoothed and
+    re-differentiated); ``p`` itself when there are none."""
+    if not values:
+        return p
+    ch = corrected_channels(p.raw, p, kin.parameters, values)
+    smooth = {c: p.filt(x) for c, x in ch.items()}
+    deriv = {c: p.differentiate(x) for c, x in ch.items()}
+    k = max(1, int(round(0.5 / p.dt)))
+    start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
+    return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
+
+
+def model_states(p: Prepared) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The states and surfaces the model is evaluated along.
+
+    A state the maneuver did not drive is held at its start: evaluated along its noise, the
+    model would pass that noise on through its derivative (errors in variables), and the
+    mismatch would then show the derivative itself as "wrong". Surfaces are measured with
+    little noise: always as recorded (holding one that moves, say by a feedback loop, would
+    be far worse than its noise). Airspeed and altitude are slow: their own optimal
+    smoothing (a far lower cut-off than the common filter's) keeps their noise out of the
+    model's coefficients (through q̂ = qc̄/2V, dynamic pressure and Mach-scheduled terms)."""
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
-    # a state the maneuver did not drive is held at its start: evaluated along its noise, the
-    # model would pass that noise on through its derivative (errors in variables), and the
-    # mismatch would then show the derivative itself as "wrong"
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven:
             states[k] = np.full(p.n, p.start[k])
-    # surfaces are measured with little noise: always evaluated as recorded (holding one that
-    # moves, say by a feedback loop, would be far worse than its noise)
     surfaces = {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth}
-    # airspeed and altitude are slow: their own optimal smoothing (a far lower cut-off than the
-    # common filter's) keeps their noise out of the model's coefficients (through q̂ = qc̄/2V,
-    # dynamic pressure and Mach-scheduled terms)
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
     if p.altitude is not None:
         states["h"] = p.altitude
-    aero = aero_along(aircraft, ic, states, surfaces, p.deriv["alpha"] if "alpha" in p.driven else None)
-    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
-    mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
-    noise = coefficient_noise(p, mismatch)
-    # 3. accelerometer position from the force mismatches
+    return states, surfaces
+
+
+def _inner(p: Prepared) -> slice:
+    """The maneuver's interior: the first and last second are where the smoother is least
+    accurate."""
+    k = max(1, int(round(1.0 / p.dt)))
+    return slice(k, p.n - k)
+
+
+def _offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                      measured: dict[str, np.ndarray]) -> tuple[cand.OffsetTest, Candidate]:
+    """The accelerometer position from the force mismatches: named when significant, at
+    least 1.5 ft and at least 4 % of the force coefficients' excursion; when named, its
+    columns are removed from ``mismatch`` (in place)."""
     off = cand.accelerometer_offset(p, mismatch, noise)
     x, sx = off.position_ft[0], off.std_error_ft[0]
-    t_best = max(abs(v) for v in off.t)
     cols = cand.accelerometer_columns(p)
-    inner_k = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
-    off_share = max(cand.contribution_share(sum(off.position_ft[i] * cols[a][c] for i, a in enumerate("xyz"))[inner_k],
-                                            1.0, measured[c][inner_k]) for c in ("CX", "CY", "CZ"))
-    off_sel = (t_best >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"] and off.gain >= cand.MIN_GAIN / 2
-               and off_share >= cand.PRACTICAL_SHARE)
-    cands.append(Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
-                           x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", off_sel,
-                           "significant and practical" if off_sel else
-                           "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion",
-                           {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
-                            "t_xyz": list(off.t)}))
-    if off_sel:
+    inner = _inner(p)
+    share = max(cand.contribution_share(sum(off.position_ft[i] * cols[a][c] for i, a in enumerate("xyz"))[inner],
+                                        1.0, measured[c][inner]) for c in ("CX", "CY", "CZ"))
+    sel = (max(abs(v) for v in off.t) >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"]
+           and off.gain >= cand.MIN_GAIN / 2 and share >= cand.PRACTICAL_SHARE)
+    if sel:
         for i, a in enumerate("xyz"):
             for c in ("CX", "CY", "CZ"):
                 mismatch[c] = mismatch[c] - off.position_ft[i] * cols[a][c]
-    # 4. delay scans
+    return off, Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
+                          x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", sel,
+                          "significant and practical" if sel else
+                          "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion",
+                          {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
+                           "t_xyz": list(off.t)})
+
+
+def _delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
+                 noise: dict[str, float]) -> dict[str, cand.DelayScan]:
+    """A delay scan per moved surface; a delay refined beyond the scanned range is not an
+    actuator delay, and its column is not offered (it would stand in for another error)."""
     delays = {}
     for s in ("de", "da", "dr"):
         scan = cand.delay_scan(p, s, mismatch, aero.derivatives, noise)
-        # a delay refined beyond the scanned range is not an actuator delay: its column is
-        # not offered (it would stand in for some other model error)
         if scan is not None and scan.tau_s <= cand.DELAY_GRID_S[-1]:
             delays[s] = scan
-    # 5. per-axis stepwise
-    selections = {}
-    propeller = has_propeller(aircraft.model)
-    nuisances: dict[str, dict[str, np.ndarray]] = {}
-    not_offered: dict[str, list[str]] = {}
-    shares: dict[tuple[str, str], float] = {}
-    inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
+    return delays
+
+
+@dataclass(frozen=True)
+class _Stepwise:
+    selections: dict        # axis -> (ColoredSelection, {key: Term})
+    nuisances: dict         # axis -> {name: column} always in the fit
+    not_offered: dict       # axis -> terms not offered, with the reason
+    shares: dict            # (axis, key) -> share of the coefficient's excursion
+
+
+def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str, np.ndarray],
+              mismatch: dict[str, np.ndarray], delays: dict) -> _Stepwise:
+    """Per-axis colored forward selection over the offered candidate terms (and the delay
+    columns), with the thrust nuisance where thrust was not recorded; drift terms that thrust
+    or a propeller would imitate are not offered."""
+    selections, nuisances, not_offered, shares = {}, {}, {}, {}
+    inner = _inner(p)
     for axis in COEFFICIENTS:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
                              for t in skipped]
         nuisance = _thrust_nuisance(p, axis, terms)
-        if "thrust_dV" in nuisance:
+        why = NO_THRUST_DRIFT if "thrust_dV" in nuisance else PROPELLER_DRIFT if (axis in cand.LAT and propeller) \
+            else None
+        if why:
             not_offered[axis] += [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources),
-                                   "reason": NO_THRUST_DRIFT} for t in terms if t.key == "dV"]
-            terms = [t for t in terms if t.key != "dV"]
-        if axis in cand.LAT and propeller:
-            not_offered[axis] += [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources),
-                                   "reason": PROPELLER_DRIFT} for t in terms if t.key == "dV"]
+                                   "reason": why} for t in terms if t.key == "dV"]
             terms = [t for t in terms if t.key != "dV"]
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
         sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra, forced=nuisance)
@@ -209,42 +289,43 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
         selections[axis] = (sel, by_key)
         nuisances[axis] = nuisance
-    cands += _aero_candidates(selections, delays, p.dt, shares)
+    return _Stepwise(selections, nuisances, not_offered, shares)
+
+
+def _slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],
+                    surfaces: dict[str, np.ndarray], alphadot: np.ndarray | None, aero: AeroAlong):
+    """``slope_of(x)``: the model's ∂C/∂x along the states (:mod:`rivals`), evaluated on first
+    use and kept."""
     slopes: dict[str, dict[str, np.ndarray]] = {}
 
     def slope_of(x: str) -> dict[str, np.ndarray]:
-        # the model's ∂C/∂x along the states (rivals module docstring), computed once per angle
         if x not in slopes:
             shifted = dict(states)
             shifted[x] = np.asarray(states[x], dtype=float) + rivals.SLOPE_STEP_RAD
-            moved = aero_along(aircraft, ic, shifted, surfaces, p.deriv["alpha"] if "alpha" in p.driven else None)
+            moved = aero_along(aircraft, ic, shifted, surfaces, alphadot)
             slopes[x] = {c: (moved.coefficients[c] - aero.coefficients[c]) / rivals.SLOPE_STEP_RAD
                          for c in COEFFICIENTS}
         return slopes[x]
+    return slope_of
 
-    _withhold_explained_by_cg(cands, selections, mismatch, p)
-    _withhold_rivals(cands, selections, nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
-    _withhold_ambiguous(cands, kin)
-    if turbulent:
-        _withhold_in_turbulence(cands)
-    # 6. spectra and gusts
-    peak = structural_peak(p)
+
+def _spectral_candidates(peak, gust, turbulent: bool) -> list[Candidate]:
+    """The structural-mode peak (named at p < :data:`FISHER_P`) and the gust level (named in
+    turbulence)."""
+    out = []
     if peak is not None:
         sel = peak.p_value < FISHER_P
-        cands.append(Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
-                               peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), peak.g, "Hz",
-                               "residual-spectrum peak over its local median", sel,
-                               f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else ""),
-                               {"amplitude": peak.amplitude}))
-    gsel = turbulent
-    cands.append(Candidate("turbulence", None, None, "sigma_gust_fps", max(gust.sigma_w_fps, gust.sigma_v_fps),
-                           max(gust.sigma_w_fps, gust.sigma_v_fps) / 4.0, gust.ratio_to_noise, 0.0, "ft/s",
-                           "air-relative vs inertial velocity (integrated kinematic residual)", gsel,
-                           f"gust/noise ratio {gust.ratio_to_noise:.1f}",
-                           {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}))
-    return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
-                    selections=selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
-                    not_offered=not_offered)
+        out.append(Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
+                             peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), peak.g, "Hz",
+                             "residual-spectrum peak over its local median", sel,
+                             f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else ""),
+                             {"amplitude": peak.amplitude}))
+    sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
+    out.append(Candidate("turbulence", None, None, "sigma_gust_fps", sigma, sigma / 4.0, gust.ratio_to_noise, 0.0,
+                         "ft/s", "air-relative vs inertial velocity (integrated kinematic residual)", turbulent,
+                         f"gust/noise ratio {gust.ratio_to_noise:.1f}",
+                         {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}))
+    return out
 
 
 def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
@@ -263,7 +344,7 @@ def _withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch
     cg = next((c for c in cands if c.selected and c.effect == "cg_offset"), None)
     if cg is None:
         return
-    inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
+    inner = _inner(p)
     for axis, (sel, by_key) in selections.items():
         if axis == cg.channel or "cg" not in by_key:
             continue
@@ -311,7 +392,7 @@ def _withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, 
     collinear candidate of the same axis, or a vane bias the kinematics cannot rule out. A
     term that survives keeps its strongest collinear rival in ``details['rival']`` for the
     validation maneuver to judge."""
-    inner = slice(max(1, int(round(1.0 / p.dt))), p.n - max(1, int(round(1.0 / p.dt))))
+    inner = _inner(p)
     for c in cands:
         if not c.selected or c.channel not in selections:
             continue
