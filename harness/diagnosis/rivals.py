@@ -32,10 +32,11 @@ import numpy as np
 
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
+from estimators.result import COLLINEARITY_LIMIT
 
-# Columns correlated at least this much are rivals: the collinearity limit of the seed's
-# §IV (pairwise |r| > 0.9 marks regressors whose estimates the data cannot separate).
-RIVAL_CORRELATION = 0.9
+# Columns correlated at least this much are rivals: the seed's collinearity limit (§III.G,
+# pairwise |r| > 0.9 marks regressors whose estimates the data cannot separate).
+RIVAL_CORRELATION = COLLINEARITY_LIMIT
 # A vane bias is ruled out by the kinematics only when it lies more than this many of their
 # standard errors from their estimate.
 KINEMATIC_Z = 3.0
