@@ -8,13 +8,13 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from models.constants import G0_MPS2
 from models.errors import UserError
 
 T0_K = 288.15
 P0_PA = 101325.0
 LAPSE_K_PER_M = 0.0065
 R_J_PER_KG_K = 287.05287
-G0_MPS2 = 9.80665
 TROPOPAUSE_M = 11000.0
 TOP_M = 20000.0
 FT_M = 0.3048

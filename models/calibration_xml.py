@@ -32,10 +32,10 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from models.constants import SURFACES
 from models.hidden import COEFFICIENTS, REGRESSORS, HiddenEffect, add_hidden_aerodynamics
 
 KINDS = ("scale", "increment", "term", "delay", "mass")
-SURFACES = ("de", "da", "dr")
 MASS_SCALES = ("ixx", "iyy", "izz", "emptywt")
 MASS_INCREMENTS = ("ixz", "cg_x", "cg_y", "cg_z", "aero_rp_x", "aero_rp_y", "aero_rp_z")
 # Axis name -> the reference length property of its coefficient (None: a force axis).

@@ -12,9 +12,9 @@ from harness.cli import main
 from harness.column_map import import_with_map, recording_to_text
 from harness.recording_io import read_recording, write_recording
 from maneuvers.recording import Recording
+from models.constants import G0_MPS2 as G
 
 FT = 0.3048
-G = 9.80665
 PSF_PA = 47.88025898033584
 SI_COLUMNS = {  # canonical column -> (the user's header, factor from canonical to the user's unit)
     "t_s": ("time_ms", 1000.0), "alpha_rad": ("AoA", 1.0), "q_rps": ("pitch_rate", 1.0),

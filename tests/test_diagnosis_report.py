@@ -10,13 +10,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from models.constants import BODY_COEFFICIENTS as COEFFICIENTS
 from reports.diagnosis_report import (affected_channels, affected_coefficients, diagnosis_report,
                                       write_diagnosis_report)
 from reports.html import html_text
 from reports.render import PNG_SIGNATURE, Report, format_number
 
 CHANNELS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
-COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
 IMG = re.compile(r'<img\s[^>]*src="([^"]*)"')
 
 

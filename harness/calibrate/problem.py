@@ -15,13 +15,13 @@ from harness.errors import UserError
 from harness.isa import density_altitude_ft
 from models.aircraft import MODELS, Aircraft, is_xml_model, model_xml, nominal_tree
 from models.calibration_xml import Adjustment, adjusted_tree, check_adjustments, delays
+from models.constants import SURFACES
 from models.flight import FlightError
 from models.jsbsim_root import write_root
 from models.mass import MassProperties, set_mass_properties
 from models.replay import InitialCondition, initial_condition, replay
 from models.trim import TrimError
 
-SURFACES = ("de", "da", "dr")
 START_WINDOW_S = 0.5
 HOLDS = ("linear", "sample")
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
