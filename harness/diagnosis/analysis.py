@@ -15,7 +15,7 @@ from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficie
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
 from models.aircraft import Aircraft, has_propeller
 from models.replay import AeroAlong, InitialCondition, aero_along
-from models.constants import G0_FPS2
+from models.constants import G0_FPS2, SURFACES
 
 
 @dataclass
@@ -203,7 +203,7 @@ def model_states(p: Prepared) -> tuple[dict[str, np.ndarray], dict[str, np.ndarr
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven:
             states[k] = np.full(p.n, p.start[k])
-    surfaces = {s: p.smooth[s] for s in ("de", "da", "dr") if s in p.smooth}
+    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
     if p.altitude is not None:
@@ -248,7 +248,7 @@ def _delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
     """A delay scan per moved surface; a delay refined beyond the scanned range is not an
     actuator delay, and its column is not offered (it would stand in for another error)."""
     delays = {}
-    for s in ("de", "da", "dr"):
+    for s in SURFACES:
         scan = cand.delay_scan(p, s, mismatch, aero.derivatives, noise)
         if scan is not None and scan.tau_s <= cand.DELAY_GRID_S[-1]:
             delays[s] = scan

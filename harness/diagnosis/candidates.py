@@ -15,7 +15,7 @@ import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
 from harness.diagnosis.prepare import Prepared
-from models.constants import G0_FPS2 as G0
+from models.constants import SURFACES
 
 T_IN = 5.0
 MIN_GAIN = 0.05
@@ -51,7 +51,7 @@ def regressors(p: Prepared) -> dict[str, np.ndarray]:
     s, st = p.smooth, p.start
     out = {"alpha": s["alpha"] - st["alpha"], "qhat": _hat(p, "q", geo["cbar_ft"]),
            "beta": s["beta"] - st["beta"], "phat": _hat(p, "p", geo["b_ft"]), "rhat": _hat(p, "r", geo["b_ft"])}
-    for sfc in ("de", "da", "dr"):
+    for sfc in SURFACES:
         if sfc in s:
             out[sfc] = s[sfc] - st[sfc]
     return out

@@ -10,6 +10,7 @@ from estimators.coefficients import accelerometer_at_cg, force_coefficients, mom
 from estimators.smoothing import optimal_fourier_smoother, sine_series_derivative, sine_series_filter
 from harness.isa import density_altitude_ft
 from maneuvers.recording import Recording
+from models.constants import BODY_COEFFICIENTS, SURFACES
 
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
 UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi": "rad", "theta": "rad",
@@ -17,7 +18,7 @@ UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi
          "dr": "rad", "qbar": "psf", "thrust": "lbf"}
 # Channels whose bandwidth sets the common filter (when excited): the states.
 BANDWIDTH_CHANNELS = ("alpha", "beta", "p", "q", "r")
-COEFFICIENTS = ("CX", "CY", "CZ", "Cl", "Cm", "Cn")
+COEFFICIENTS = BODY_COEFFICIENTS  # the diagnosis works on the six body-axis coefficients
 START_WINDOW_S = 0.5
 # The states each group of surfaces drives: a state is maneuver-driven only when a surface of
 # its group moved (a symmetric airframe's pitch maneuver leaves β, p and r at their noise).
@@ -230,7 +231,7 @@ def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weig
     # a surface moved when it is excited, or when its filtered signal stands clear of the noise
     # the filter passes (a surface moved by a feedback loop every frame looks noisy sample to
     # sample, yet moves)
-    surfaces = [s for s in ("de", "da", "dr") if s in smooth and (s in excited or ratio(s) >= snr)]
+    surfaces = [s for s in SURFACES if s in smooth and (s in excited or ratio(s) >= snr)]
     out = list(surfaces)
     for state, group in DRIVEN_BY.items():
         if state not in smooth:
@@ -276,7 +277,7 @@ def undriven_reason(p: Prepared, sources: list[str] | tuple[str, ...]) -> str:
             words.append("no lateral input (aileron and rudder never moved)")
         elif s in ("alpha", "q", "V") and not longitudinal:
             words.append("no longitudinal input (the stabilator never moved)")
-        elif s in ("de", "da", "dr"):
+        elif s in SURFACES:
             words.append(f"{_SOURCE_WORDS[s]} never moved")
         elif s == "V":
             words.append("the airspeed never moved above its noise (no phugoid)")
