@@ -272,6 +272,19 @@ def test_gallery_turbulence_is_modelled_by_flying_through_the_reconstructed_gust
         assert after[ch]["rms"] < 0.7 * before[ch]["rms"], (ch, before[ch]["rms"], after[ch]["rms"])
 
 
+def test_gallery_turbulence_becomes_a_process_noise_model(gallery):
+    """Filter error's gust state on the recording itself: its σ_w is the gust the kinematics
+    saw (the gallery's moderate Dryden: σ about 4.6-7.7 ft/s), and its Kalman filter follows
+    the flight far better than output error without the gust."""
+    pm = gallery["turbulence"]["findings"][0]["evidence"]["process_noise_model"]
+    assert pm["fitted"]
+    assert 3.0 < pm["sigma_w_fps"] < 12.0
+    assert abs(pm["sigma_w_fps"] - 6.0) < 3.0 * pm["sigma_w_std_error_fps"] + 1.0
+    assert pm["rms_filter_error"]["alpha"] < 0.5 * pm["rms_output_error"]["alpha"]
+    for o in ("q", "az"):
+        assert pm["rms_filter_error"][o] < pm["rms_output_error"][o]
+
+
 def test_gallery_structural_mode_is_modelled_as_a_notch(gallery):
     f = gallery["structural_mode"]["findings"][0]
     before, after = f["fit_before"]["validation"]["outputs"], f["fit_after"]["validation"]["outputs"]

@@ -8,6 +8,7 @@ import numpy as np
 
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import rivals
+from harness.diagnosis.gusts import process_noise_model
 from estimators.colored_stepwise import colored_fit
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
                                           is_plausible, is_practical, kinematic_check, kinematic_residuals)
@@ -108,6 +109,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += _spectral_candidates(peak, gust, turbulent)
+    if turbulent:  # the gust as a process-noise model: filter error against output error
+        next(c for c in cands if c.effect == "turbulence").details["process_noise_model"] = process_noise_model(p)
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
                     selections=step.selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
                     not_offered=step.not_offered)

@@ -80,6 +80,7 @@ class Prepared:
     driven: tuple[str, ...] = ()
     assumptions: tuple[dict, ...] = ()  # what stood in for missing channels or metadata
     altitude: np.ndarray | None = None  # ft: the h channel (own smoothing), or its stand-in
+    recording: Recording | None = None  # the recording itself (for model fits that need its channels)
 
     @property
     def n(self) -> int:
@@ -175,7 +176,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
                     cutoff_hz={c: f.cutoff_hz for c, f in fits.items()}, weights=w, common_cutoff_hz=cutoff,
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
                     own_noise=own_noise, mass=mass, driven=driven, assumptions=tuple(assumptions),
-                    altitude=altitude)
+                    altitude=altitude, recording=rec)
 
 
 def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...]) -> list[dict]:
