@@ -203,7 +203,8 @@ def _add_diagnose(sub) -> None:
                                         "show the fit improve",
                        description="Compare a model with a recording (canonical format): replay the recorded "
                                    "surfaces from trim, locate the mismatch, test every effect of effects.md, add "
-                                   "the significant ones to the model and fly it again. Writes OUT/findings.json, "
+                                   "the significant ones to the model, refine their sizes with JSBSim in the loop "
+                                   "(--calibrate) and fly it again. Writes OUT/findings.json, "
                                    "OUT/report.html, OUT/series/*.parquet and OUT/model/ (the augmented aircraft).")
     g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6), or the path of a "
                                                    "JSBSim aircraft XML")
@@ -213,6 +214,12 @@ def _add_diagnose(sub) -> None:
     g.add_argument("--recording", required=True, help="identification recording (.csv beside .meta.json, or .parquet)")
     g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
     g.add_argument("--out", required=True, help="output folder")
+    g.add_argument("--calibrate", action=argparse.BooleanOptionalAction, default=True,
+                   help="last step: refine the added aerodynamic and delay terms with JSBSim in the loop (output "
+                        "error, as sidbench calibrate), keeping the calibrated sizes only when the identification "
+                        "fit and the validation RMS of the outputs they drive are at least as good (default: on; "
+                        "surfaces held sample to sample for a simulated recording, interpolated for flight data)")
+    g.add_argument("--workers", type=int, default=2, help="processes flying the calibration's flights (default 2)")
     g.set_defaults(func=lambda a: _commands().cmd_diagnose(a))
 
 

@@ -7,6 +7,7 @@ whose other folders link back to the package's own.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import tempfile
@@ -39,8 +40,11 @@ def strip_io(tree: ET.ElementTree) -> ET.ElementTree:
 
 
 def _link(src: Path, dst: Path) -> None:
+    """Link ``dst`` to ``src`` unless it is there; processes writing the same root at once
+    (a calibration's parallel flights) may both find it missing: the loser's link exists."""
     if not dst.exists() and not dst.is_symlink():
-        dst.symlink_to(src, target_is_directory=src.is_dir())
+        with contextlib.suppress(FileExistsError):
+            dst.symlink_to(src, target_is_directory=src.is_dir())
 
 
 def engine_root(source: Path) -> Path:

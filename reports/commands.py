@@ -77,7 +77,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     """Run the discrepancy diagnosis and write its report."""
     from harness.diagnosis.run import diagnose
     from reports.diagnosis_report import write_diagnosis_report
-    result = diagnose(args.model, args.recording, args.out, args.validation, mass=args.mass)
+    result = diagnose(args.model, args.recording, args.out, args.validation, mass=args.mass,
+                      calibrate=getattr(args, "calibrate", True), calibrate_workers=getattr(args, "workers", 2))
     html = write_diagnosis_report(Path(args.out))
     for f in result["findings"]:
         if f["effect"] == "none":
@@ -87,6 +88,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
                   f"  (t = {f['evidence']['t']:.1f})")
             print(f"    {f['explanation']}")
     print(f"{result['located']['summary']}")
+    cal = result.get("calibration") or {}
+    if "hold" in cal:
+        print(f"calibration in the loop {'used' if cal['used'] else 'not used'}: {cal['reason']}")
     print(f"diagnosis took {result['timing_s']['total']:.1f} s; wrote {Path(args.out) / 'findings.json'} and {html}")
     return 0
 

@@ -15,9 +15,14 @@ from models.hidden import AERO_TERMS
 
 
 def findings_parameters(findings: dict) -> list[str]:
-    """``NAME=SIZE`` for each aerodynamic or delay term of a diagnosis (findings.json's content)."""
+    """``NAME=SIZE`` for each aerodynamic or delay term of a diagnosis (findings.json's content),
+    at its equation-error size (a diagnosis that kept its calibrated sizes lists them in
+    ``calibration.parameters`` beside the equation-error ones)."""
     terms = (findings.get("model") or {}).get("terms") or []
-    return [f"{t['parameter']}={float(t['size'])!r}" for t in terms
+    calibration = findings.get("calibration") or {}
+    ee = {p["name"]: p["equation_error"] for p in calibration.get("parameters") or []
+          if calibration.get("used") and p.get("equation_error") is not None}
+    return [f"{t['parameter']}={float(ee.get(t['parameter'], t['size']))!r}" for t in terms
             if t.get("effect") in AERO_TERMS + ("control_delay",)]
 
 
@@ -42,7 +47,7 @@ def auto_parameters(spec: str, model: str, recording, validation, mass: str) -> 
         from harness.diagnosis.run import diagnose
         with tempfile.TemporaryDirectory(prefix="sidbench-calibrate-auto-") as d:
             doc = diagnose(model, recording, Path(d) / "diagnosis",
-                           validation if isinstance(validation, (str, Path)) else None, mass=mass)
+                           validation if isinstance(validation, (str, Path)) else None, mass=mass, calibrate=False)
     found = findings_parameters(doc)
     if not found:
         raise CalibrationError(f"--parameters {spec}: the diagnosis added no aerodynamic or delay term to the "

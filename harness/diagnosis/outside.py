@@ -42,6 +42,7 @@ from scipy import signal
 
 from harness.atomic import write_text_atomic
 from harness.diagnosis.gallery import StructuralMode, conceal
+from harness.diagnosis.refine import validation_rms_pair
 from harness.diagnosis.sweep import run_resumable
 from harness.noise import ChannelNoise, NoiseModel, apply_noise
 from harness.noise_presets import WHITE_LEVELS
@@ -447,10 +448,15 @@ def score(c: OutsideCase, result: dict) -> dict:
             row["d"] = False
             if "validation" in first.get("fit_before", {}) and first["effect"] != "none":
                 before = first["fit_before"]["validation"]["outputs"].get(c.channel, {}).get("rms")
-                after = first["fit_after"]["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
+                # d is scored on the equation-error sizes, as before the calibration step
+                ee = first.get("fit_after_equation_error") or first["fit_after"]
+                after = ee["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
                 if before and after is not None:
                     row["validation_rms"] = [before, after]
                     row["d"] = bool(row["a"] and 1.0 - after / before >= BAR_DROP)
+    # the calibration step's column: the affected output's validation RMS after the
+    # equation-error and after the calibrated sizes, and which the diagnosis kept
+    row["calibration"] = validation_rms_pair(result.get("calibration") or {}, c.channel)
     row["false"] = [f"{f['effect']}:{f['parameter']}" for f in false]
     row["c"] = len(false)
     return row
@@ -462,8 +468,9 @@ def run_case(c: OutsideCase, out: Path) -> dict:
     from harness.diagnosis.run import diagnose
     try:
         paths = write_case(c, out / "recordings")
+        # the sweep's own processes are the parallelism: the calibration flies in-process
         result = diagnose(c.condition.model, paths["identification"], out / "diagnoses" / c.name,
-                          paths["validation"])
+                          paths["validation"], calibrate_workers=1)
         row = score(c, result) | {"timing_s": result["timing_s"]["total"], "error": None}
     except Exception as exc:  # noqa: BLE001 - a measurement: the row says what broke
         row = {"case": c.name, "aircraft": c.condition.aircraft, "where": c.where, "condition": c.condition.condition,

@@ -14,6 +14,7 @@ from scipy import signal
 
 from harness.atomic import write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
+from harness.diagnosis import refine
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason
@@ -273,23 +274,29 @@ def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
     return initial_condition(p.t, ch["V"], ch["alpha"], ch.get("h"))
 
 
-def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
-              findings: list[Candidate] | None, analysis: Analysis):
-    """Replays before/after and fits for one analysed maneuver; on the validation maneuver
-    the identification's findings are applied as predictions."""
-    ic = analysis.ic
+def _replay_before(p: Prepared, aircraft: Aircraft, analysis: Analysis):
+    """The model as given, replayed over one maneuver: ``(history, None)`` or ``(None, why)``."""
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
-    before_hist, before_failed = None, None
     try:
-        before_hist, _ = replay(aircraft, ic, p.t, surfaces)
+        return replay(aircraft, analysis.ic, p.t, surfaces)[0], None
     except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
-        before_failed = str(exc)
+        return None, str(exc)
+
+
+def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
+              findings: list[Candidate] | None, analysis: Analysis, before=None, refs: dict | None = None):
+    """Replays before/after and fits for one analysed maneuver; on the validation maneuver
+    the identification's findings are applied as predictions. ``before`` reuses an earlier
+    :func:`_replay_before` of the same maneuver; ``refs`` are the trim references of the added
+    terms (default: the nominal model's trim at the maneuver's start, :func:`models.hidden.hidden_root`)."""
+    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
+    before_hist, before_failed = before if before is not None else _replay_before(p, aircraft, analysis)
     after_hist, diverged = before_hist, before_failed
     winds = _turbulence_winds(p, analysis) if any(f.effect == "turbulence" for f in findings or []) else None
     if (added or winds is not None) and before_failed is None:
         try:
             after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), _true_start(p, added), p.t, surfaces,
-                                   wind_ned_fps=winds)
+                                   wind_ned_fps=winds, refs=refs)
         except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient fits still stand
             after_hist, diverged = None, str(exc)
     a = analysis
@@ -653,11 +660,15 @@ def incomplete_marker(out: Path):
 
 
 def diagnose(model: str, recording: str | Path, out: str | Path, validation: str | Path | None = None, *,
-             mass: str = "model") -> dict:
+             mass: str = "model", calibrate: bool = True, calibrate_workers: int = 2) -> dict:
     """Diagnose ``recording`` against ``model``; write ``out``; return findings.json's content.
 
     ``mass='recording'`` flies the model with the recording's mass and inertia
-    (:func:`models.mass.set_mass_properties`) instead of its own.
+    (:func:`models.mass.set_mass_properties`) instead of its own. ``calibrate`` refines the
+    kept aerodynamic and delay terms with JSBSim in the loop as the last step
+    (:mod:`harness.diagnosis.refine`; ``calibrate_workers`` processes fly its flights, 1: in
+    this process); the calibrated sizes are kept only when they fit at least as well, and
+    findings.json's ``calibration`` block says which and why.
 
     Raises
     ------
@@ -665,10 +676,64 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
         For an unknown model; recording, trim and flight errors name their cause themselves.
     """
     with incomplete_marker(Path(out)) as folder:
-        return _diagnose(model, recording, folder, validation, mass=mass)
+        return _diagnose(model, recording, folder, validation, mass=mass, calibrate=calibrate,
+                         workers=calibrate_workers)
 
 
-def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str) -> dict:
+def _fly_all(maneuvers: dict, aircraft: Aircraft, added: tuple[HiddenEffect, ...], modelled: list[Candidate],
+             befores: dict, refs: dict | None = None) -> dict:
+    """:func:`_maneuver` for each role of ``maneuvers`` (role -> (prepared, analysis)), the
+    model as given flown once (``befores``): role -> (analysis, fit before, fit after, series)."""
+    return {role: _maneuver(pm, aircraft, added, modelled, am, befores[role], refs)
+            for role, (pm, am) in maneuvers.items()}
+
+
+def _refine(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int, maneuvers: dict, befores: dict,
+            modelled: list[Candidate], added: tuple[HiddenEffect, ...], flown: dict):
+    """The last step: calibrate the kept aircraft terms in the loop and keep the calibrated sizes
+    only when they fit at least as well (:func:`refine.decide`).
+
+    Returns
+    -------
+    (block, modelled, added, flown)
+        findings.json's ``calibration`` block, and the findings, terms and flights to report:
+        the calibrated ones when used, else those given.
+    """
+    from harness.calibrate import CalibrationError
+    from harness.calibrate import calibrate as calibrate_in_loop
+    pairs = refine.calibratable([(f, _effect_of(f)) for f in modelled])
+    if not pairs:
+        return ({"used": False, "reason": "no aerodynamic or delay term was added: nothing to calibrate"},
+                modelled, added, flown)
+    terms = [e for _, e in pairs]
+    hold, hold_reason = refine.surface_hold(recs["identification"].meta)
+    block = {"used": False, "hold": hold, "hold_assumption": hold_reason, "workers": workers}
+    try:
+        cal = calibrate_in_loop(model, [recs["identification"]], refine.parameter_spec(terms),
+                                validation=[recs["validation"]] if "validation" in recs else None, workers=workers,
+                                mass=mass, hold=hold)
+    except (CalibrationError, FlightError, TrimError, RuntimeError, ValueError, OSError) as exc:
+        # the last step never takes the diagnosis down: the equation-error sizes stand
+        return block | {"reason": f"the calibration could not run: {type(exc).__name__}: {exc}"}, modelled, added, flown
+    sizes = {a.name: float(v) for a, v in zip(cal.adjustments, cal.estimate)}
+    refined = refine.refined_findings(pairs, sizes, dict(zip((a.name for a in cal.adjustments), cal.std_error)))
+    modelled_cal = [refined[id(f)][0] if id(f) in refined else f for f in modelled]
+    added_cal = refine.refined_terms(added, sizes)
+    # the calibrated sizes belong to the calibration's term references (its unadjusted model's
+    # trim at the recording's start): the augmented model is flown and written with them
+    flown_cal = _fly_all(maneuvers, aircraft, added_cal, modelled_cal, befores, dict(cal.refs))
+    fits_ee = {r: v[2] for r, v in flown.items()}
+    fits_cal = {r: v[2] for r, v in flown_cal.items()}
+    used, reason, figures = refine.decide(cal, fits_ee, fits_cal, refine.affected_outputs(terms))
+    block |= {"used": used, "reason": reason, **refine.calibration_detail(cal, terms, fits_ee, fits_cal), **figures,
+              "findings": {f.parameter: refined[id(f)][1] for f in modelled if id(f) in refined}}
+    if used:
+        return block, modelled_cal, added_cal, flown_cal
+    return block, modelled, added, flown
+
+
+def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str,
+              calibrate: bool = True, workers: int = 2) -> dict:
     t0 = time.perf_counter()
     aircraft = _aircraft(model)
     rec = read_recording(recording)
@@ -684,8 +749,10 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     checks: dict[int, dict | None] = {}
     unconfirmed: list[Candidate] = []
     av = None
+    recs = {"identification": rec}
     if validation is not None:
-        pv = prepare(read_recording(validation), "validation")
+        recs["validation"] = read_recording(validation)
+        pv = prepare(recs["validation"], "validation")
         av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.altitude))
         checks = {id(f): validation_check(av, f) for f in findings}
     else:
@@ -699,7 +766,16 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     timing = {"analysis": time.perf_counter() - t0}
     # the recording as prepared (``a.prepared`` carries the sensor corrections; fits are
     # against what was recorded)
-    _, fb_id, fa_id, series_id = _maneuver(p, aircraft, added, modelled, a)
+    maneuvers = {"identification": (p, a)} | ({"validation": (pv, av)} if av is not None else {})
+    befores = {role: _replay_before(pm, aircraft, am) for role, (pm, am) in maneuvers.items()}
+    flown = _fly_all(maneuvers, aircraft, added, modelled, befores)
+    calibration = {"used": False, "reason": "not asked for (calibrate=False, --no-calibrate)"}
+    if calibrate:
+        t1 = time.perf_counter()
+        calibration, modelled, added, flown = _refine(model, recs, aircraft, mass, workers, maneuvers, befores,
+                                                      modelled, added, flown)
+        timing["calibration"] = time.perf_counter() - t1
+    _, fb_id, fa_id, series_id = flown["identification"]
     fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
     series = {"identification": series_id}
     located = _located(a, fb_id, "identification", _focus_axis(findings))
@@ -716,18 +792,20 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
             located["summary"] += (f" After the findings, no axis's mismatch is above {UNEXPLAINED_RATIO:g} times its "
                                    f"noise level (largest: {worst}, {w['ratio']:.1f}).")
     if av is not None:
-        av, fb_v, fa_v, series_v = _maneuver(pv, aircraft, added, modelled, av)
+        av, fb_v, fa_v, series_v = flown["validation"]
         fits_b["validation"], fits_a["validation"] = fb_v, fa_v
         series["validation"] = series_v
         located["outputs"]["validation"] = _located(av, fb_v, "validation")["outputs"]["validation"]
     timing["total"] = time.perf_counter() - t0
-    model_info = _write_model(out, aircraft, ic, added, _sensor_models(modelled))
+    model_info = _write_model(out, aircraft, ic, added, _sensor_models(modelled),
+                              calibration.get("references") if calibration["used"] else None)
     result = {
-        "findings": [_finding_dict(f, fits_b, fits_a, checks.get(id(f))) for f in findings]
-        or [_none_finding(a, fits_b)],
+        "findings": [_with_calibration(_finding_dict(f, fits_b, fits_a, checks.get(id(f))), calibration)
+                     for f in findings] or [_none_finding(a, fits_b)],
         "located": located,
         "not_confirmed": [_finding_dict(f, {}, {}, checks.get(id(f))) for f in unconfirmed],
-        "assumptions": assumptions(a, aircraft, mass),
+        "calibration": calibration,
+        "assumptions": assumptions(a, aircraft, mass) + _calibration_assumptions(calibration),
         "not_checked": not_checked(a, validation is not None),
         "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
         "candidates": [c.as_dict() for c in sorted(a.candidates, key=lambda c: -abs(c.t))],
@@ -743,6 +821,32 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         write_atomic(out / "series" / f"{name}.parquet", lambda fh, df=df: df.to_parquet(fh, index=False))
     write_text_atomic(out / "findings.json", json.dumps(_jsonable(result), indent=1))
     return result
+
+
+def _with_calibration(d: dict, calibration: dict) -> dict:
+    """A finding's dict with its calibrated size and standard error (``calibrated``: the size in
+    the model when the calibration was used, else only reported), the equation-error fits
+    beside the calibrated ones, and a sentence in the explanation."""
+    own = (calibration.get("findings") or {}).get(d["parameter"])
+    if own is None:
+        return d
+    d["calibrated"] = own | {"used": bool(calibration["used"])}
+    if calibration["used"]:
+        d["fit_after_equation_error"] = calibration["fit_after_equation_error"]
+        d["explanation"] += (f" Refined with JSBSim in the loop: {own['estimate']:.4g} ± {own['std_error']:.2g}, the "
+                             "size the augmented model flies with.")
+    else:
+        d["explanation"] += (f" Calibrated with JSBSim in the loop it would be {own['estimate']:.4g} ± "
+                             f"{own['std_error']:.2g}; the equation-error size is kept ({calibration['reason']}).")
+    return d
+
+
+def _calibration_assumptions(calibration: dict) -> list[dict]:
+    """The calibration step's assumption (how its replay holds the recorded surfaces)."""
+    if "hold" not in calibration:
+        return []
+    return [{"item": "surfaces between samples (calibration)", "missing": "-",
+             "stood_in_by": f"{calibration['hold']}: {calibration['hold_assumption']}"}]
 
 
 def _sensor_models(findings: list[Candidate]) -> list[dict]:
@@ -762,7 +866,7 @@ def _sensor_models(findings: list[Candidate]) -> list[dict]:
 
 
 def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ...],
-                 other: list[dict] | None = None) -> dict:
+                 other: list[dict] | None = None, refs: dict | None = None) -> dict:
     """Copy the augmented aircraft (XML) into ``out/model``; sensor effects (and a structural
     mode's notch, the turbulence model) are listed in ``sensors.json`` beside it (they change
     what the instruments record, or the air the aircraft flies through, not the aircraft)."""
@@ -774,7 +878,7 @@ def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, .
     if not any(not e.effect.startswith("sensor_") for e in added):
         return {"base": aircraft.model, "augmented_xml": None, "terms": terms,
                 "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
-    root, name = hidden_root(Aircraft(aircraft.model, hidden=added), ic.condition())
+    root, name = hidden_root(Aircraft(aircraft.model, hidden=added), ic.condition(), refs)
     src = root / "aircraft" / name / f"{name}.xml"
     target = dest / f"{aircraft.name}-diagnosed.xml"
     write_atomic(target, lambda fh: fh.write(src.read_bytes()))

@@ -21,6 +21,7 @@ from pathlib import Path
 from harness.atomic import write_text_atomic
 from harness.diagnosis.gallery import (GalleryCase, StructuralMode, identification_input, validation_input,
                                        write_case)
+from harness.diagnosis.refine import validation_rms_pair
 from harness.diagnosis.run import diagnose
 from maneuvers.combine import Sequence, Simultaneous
 from maneuvers.multistep import MultiStep, multistep
@@ -161,7 +162,9 @@ def score(c: SweepCase, result: dict) -> dict:
     row["d"] = None
     if c.channel and "validation" in first.get("fit_before", {}) and first["effect"] != "none":
         before = first["fit_before"]["validation"]["outputs"].get(c.channel, {}).get("rms")
-        after = first["fit_after"]["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
+        # d is scored on the equation-error sizes, as before the calibration step
+        ee = first.get("fit_after_equation_error") or first["fit_after"]
+        after = ee["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
         if before and after is not None:
             row["validation_rms"] = [before, after]
             row["d"] = bool(row["a"] and 1.0 - after / before >= BAR_DROP)
@@ -174,8 +177,11 @@ def run_case(c: SweepCase, out: Path) -> dict:
     """Make, diagnose and score one case; its row is written to ``out/results/<case>.json``."""
     paths = write_case(GalleryCase(c.name, c.effects, c.parameter, c.truth, c.turbulence, c.mode),
                        out / "recordings", c.seed, INPUTS[c.inputs]())
-    result = diagnose("f16", paths["identification"], out / "diagnoses" / c.name, paths["validation"])
-    row = score(c, result) | {"seed": c.seed, "inputs": c.inputs, "timing_s": result["timing_s"]["total"]}
+    # the sweep's own processes are the parallelism: the calibration flies in-process
+    result = diagnose("f16", paths["identification"], out / "diagnoses" / c.name, paths["validation"],
+                      calibrate_workers=1)
+    row = score(c, result) | {"seed": c.seed, "inputs": c.inputs, "timing_s": result["timing_s"]["total"],
+                              "calibration": validation_rms_pair(result.get("calibration") or {}, c.channel)}
     write_text_atomic(out / "results" / f"{c.name}.json", json.dumps(row, indent=1))
     return row
 
