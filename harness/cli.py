@@ -291,8 +291,8 @@ def _add_outside_sweep(sub) -> None:
                                     "alpha and beta, 8 significant digits, no h or thrust in some): five F-16 "
                                     "conditions, two c172x conditions, pitch-only, lateral-only and three-axis "
                                     "maneuvers, every effect id, nulls and noise-free self-checks (F-16, 737, c172x). "
-                                    "Scores a: right effect and parameter first, b: size within 2 s.e. or 25 %%, "
-                                    "c: false findings, d: validation RMS -30 %%. Writes OUT/sweep.md, OUT/sweep.json "
+                                    "Scores a: right effect and parameter first, b: size within 2 s.e. or 25 %, "
+                                    "c: false findings, d: validation RMS -30 %. Writes OUT/sweep.md, OUT/sweep.json "
                                     "and one result per case (a rerun resumes).")
     so.add_argument("--out", default="out/outside-sweep", help="output folder")
     so.add_argument("--case", action="append", default=None, help="one case (repeatable; default all)")
