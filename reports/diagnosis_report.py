@@ -501,7 +501,24 @@ def verdict_section(data: Mapping) -> Section:
     intro = (f"{len(real)} effect{'s' if len(real) > 1 else ''} found, most significant first. "
              "Each is a term the model as given lacks, estimated from the mismatch between the "
              "recording and the model.")
-    return Section("Verdict", (intro,), _figs(findings_table(real), evidence, unconfirmed))
+    return Section("Verdict", (intro,), _figs(findings_table(real), _calibration_table(data), evidence, unconfirmed))
+
+
+def _calibration_table(data: Mapping) -> Table | None:
+    """The last step, JSBSim in the loop (findings.json's ``calibration``): each term's
+    equation-error size against its calibrated size, and whether the calibrated one was used
+    (only when it fits the identification and the validation maneuver no worse)."""
+    cal = _dict(data.get("calibration"))
+    rows = [{"parameter": _scalar(q.get("name")), "equation error": _num(q.get("equation_error")),
+             "calibrated": _num(q.get("calibrated")), "std_error": _num(q.get("std_error")),
+             "units": _scalar(q.get("units"))}
+            for q in cal.get("parameters") or [] if isinstance(q, Mapping)]
+    if not rows:
+        return None
+    used = "used" if cal.get("used") else "not used: the equation-error sizes are kept"
+    return Table("Sizes refined in the loop", pd.DataFrame(rows),
+                 f"The named terms refined by output error over JSBSim flights of the augmented aircraft "
+                 f"(sidbench calibrate); calibrated sizes {used}. {_scalar(cal.get('reason', ''))}")
 
 
 def _unconfirmed_table(data: Mapping) -> Table | None:
