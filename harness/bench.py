@@ -256,7 +256,7 @@ def diagnosis_rows(repeat: int) -> list[BenchRow]:
         paths = write_case(case("unsteady_alphadot"), Path(tmp) / "rec", seed=1)
         seconds = best_of(lambda: diagnose("f16", paths["identification"], Path(tmp) / "d",
                                            paths["validation"]), repeat)
-        out.append(BenchRow("diagnose a 30 s F-16 recording + validation", seconds, "s", "in-process; end to end with the report about 5 s; bar < 10 s"))
+        out.append(BenchRow("diagnose a 30 s F-16 recording + validation", seconds, "s", "in-process, calibration included; end to end with the report 7-8 s (README); bar < 10 s"))
         data = Path(__file__).resolve().parents[2] / "shared" / "data" / "sidpac"
         ident, valid = data / "totter_f1_017_data.mat", data / "totter_f1_014_data.mat"
         if ident.is_file() and valid.is_file():
