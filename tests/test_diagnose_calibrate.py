@@ -9,7 +9,7 @@ import pytest
 
 from harness.calibrate.auto import findings_parameters
 from harness.diagnosis.gallery import case, write_case
-from harness.diagnosis.refine import affected_outputs, decide, surface_hold, validation_rms_pair
+from harness.diagnosis.refine import affected_outputs, decide, matched_outputs, surface_hold, validation_rms_pair
 from harness.diagnosis.run import diagnose
 from models.hidden import HiddenEffect
 
@@ -35,6 +35,8 @@ def test_the_named_term_is_refined_in_the_loop_and_flown(diagnosed):
     cal = result["calibration"]
     assert cal["used"], cal["reason"]
     assert cal["hold"] == "sample"  # a simulated recording: its stepped surfaces held
+    # the calibration matches the output the decision judges (q for a pitching moment term)
+    assert cal["matched_outputs"] == ["q"] and set(cal["calibrator_fit"]["calibrated"]["identification"]) == {"q"}
     (p,) = cal["parameters"]
     assert p["name"] == "Cm_alphadot" and p["calibrated"] != p["equation_error"] and p["std_error"] > 0
     # the truth is -3: the calibrated size within 3 of its standard errors
@@ -109,3 +111,12 @@ def test_hold_from_the_metadata_and_the_outputs_a_term_drives():
     terms = [HiddenEffect("control_delay", 0.05, surface="dr"), HiddenEffect("cross_coupling", 1.0, coefficient="Cl"),
              HiddenEffect("cg_offset", 0.5), HiddenEffect("nonlinear_alpha", 1.0, coefficient="CZ")]
     assert affected_outputs(terms) == ["r", "p", "q", "az"]
+
+
+def test_the_calibration_matches_the_outputs_the_decision_judges():
+    has = SimpleNamespace(has=lambda o: o in ("alpha", "q", "r", "az"))
+    terms = [HiddenEffect("control_delay", 0.05, surface="dr"), HiddenEffect("cross_coupling", 1.0, coefficient="Cl"),
+             HiddenEffect("cg_offset", 0.5), HiddenEffect("nonlinear_alpha", 1.0, coefficient="CZ")]
+    assert matched_outputs(terms, has) == ("r", "q", "az")  # p not recorded: not matched
+    # a recording with none of them: every output it has (the calibration's default)
+    assert matched_outputs(terms[1:2], has) is None

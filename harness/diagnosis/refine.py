@@ -1,7 +1,8 @@
 """The diagnosis's last step: the terms it names, refined with JSBSim in the loop.
 
 The kept aerodynamic and delay findings start the output-error calibration
-(:func:`harness.calibrate.calibrate`) at their equation-error sizes. The calibrated sizes
+(:func:`harness.calibrate.calibrate`) at their equation-error sizes, matching the outputs the
+terms drive (the ones the decision judges, :func:`matched_outputs`). The calibrated sizes
 replace them only when they fit at least as well: the identification maneuver's output-error
 cost is not higher, and the validation maneuver's RMS error of the outputs the terms drive
 (flown by the diagnosis's own replay) is not higher for any of them. Otherwise the
@@ -64,6 +65,20 @@ def affected_outputs(terms: list[HiddenEffect]) -> list[str]:
     return list(dict.fromkeys(out))
 
 
+def matched_outputs(terms: list[HiddenEffect], rec) -> tuple[str, ...] | None:
+    """The outputs the calibration matches: those the terms drive (:func:`affected_outputs`),
+    the outputs the decision judges, that recording ``rec`` has; None (every output the
+    recording has) when it has none of them.
+
+    Matching every output instead weighs in channels the named terms hardly drive, whose
+    errors from whatever else the model lacks then pull the sizes: on the sweeps that made
+    the calibrated sizes fit the judged output worse on both maneuvers (an α·β term sized
+    −2.61 for −2 on a coupled maneuver; an equation-error Cl_|β| that could not be moved).
+    """
+    out = tuple(o for o in affected_outputs(terms) if rec.has(o))
+    return out or None
+
+
 def output_cost(fit: dict) -> float | None:
     """The output-error cost of a flight with the noise variances estimated (Eq. 26 at its
     minimum over R, per sample and up to a constant): Σ_o ln RMS_o over the channels of
@@ -120,7 +135,7 @@ def decide(cal, fits_ee: dict, fits_cal: dict, outputs: list[str]) -> tuple[bool
     role = "validation" if "validation" in fits_ee else "identification"
     rms = {o: {"equation_error": _rms(fits_ee, role, o), "calibrated": _rms(fits_cal, role, o)} for o in outputs}
     figures = {"identification_cost": {"equation_error": cost_ee, "calibrated": cost_cal,
-                                       "definition": "sum over the calibrated outputs of ln RMS error (the "
+                                       "definition": "sum over the matched outputs of ln RMS error (the "
                                                      "output-error likelihood with the noise estimated, per sample)"},
                "judged_on": role, "affected_outputs": outputs, "rms": rms}
     if cost_ee is None or cost_cal is None:

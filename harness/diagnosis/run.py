@@ -707,11 +707,13 @@ def _refine(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int,
                 modelled, added, flown)
     terms = [e for _, e in pairs]
     hold, hold_reason = refine.surface_hold(recs["identification"].meta)
-    block = {"used": False, "hold": hold, "hold_assumption": hold_reason, "workers": workers}
+    matched = refine.matched_outputs(terms, recs["identification"])
+    block = {"used": False, "hold": hold, "hold_assumption": hold_reason, "workers": workers,
+             "matched_outputs": list(matched)}
     try:
         cal = calibrate_in_loop(model, [recs["identification"]], refine.parameter_spec(terms),
                                 validation=[recs["validation"]] if "validation" in recs else None, workers=workers,
-                                mass=mass, hold=hold)
+                                mass=mass, hold=hold, outputs=matched)
     except (CalibrationError, FlightError, TrimError, RuntimeError, ValueError, OSError) as exc:
         # the last step never takes the diagnosis down: the equation-error sizes stand
         return block | {"reason": f"the calibration could not run: {type(exc).__name__}: {exc}"}, modelled, added, flown
