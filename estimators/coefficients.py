@@ -128,15 +128,20 @@ def coefficients_from_recording(rec: Recording, differentiate: Differentiator | 
     return pd.DataFrame(_coefficients(rec, differentiate, wanted), columns=list(wanted))
 
 
-def coefficient_from_recording(rec: Recording, name: str, differentiate: Differentiator | None = None) -> np.ndarray:
+def coefficient_from_recording(rec: Recording, name: str, differentiate: Differentiator | None = None,
+                               *, accelerations: dict[str, np.ndarray] | None = None) -> np.ndarray:
     """One of the coefficients of :func:`coefficients_from_recording`, computed alone: only the
     channels (and angular accelerations) its equation uses, no frame. Bit-identical to the frame's
-    column."""
-    return _coefficients(rec, differentiate, (name,))[name]
+    column. ``accelerations`` (``{'pdot': ..., 'qdot': ..., 'rdot': ...}``, any subset) replaces
+    the recorded or differentiated angular accelerations it names: Eqs. 3-5 are affine in them,
+    so setting them to 0 and 1 gives the coefficient's parts (used by the frequency-domain
+    method to differentiate in the frequency domain)."""
+    return _coefficients(rec, differentiate, (name,), accelerations)[name]
 
 
 def _coefficients(rec: Recording, differentiate: Differentiator | None,
-                  names: tuple[str, ...]) -> dict[str, np.ndarray]:
+                  names: tuple[str, ...],
+                  accelerations: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
     unknown = [n for n in names if n not in ALL_COEFFICIENTS]
     if unknown:
         raise ValueError(f"unknown coefficient(s) {unknown}: use {ALL_COEFFICIENTS}")
@@ -144,7 +149,9 @@ def _coefficients(rec: Recording, differentiate: Differentiator | None,
 
     def rate(name: str) -> np.ndarray:  # p, q, r and (recorded or differentiated) pdot, qdot, rdot
         if name not in rates:
-            if len(name) == 1 or differentiate is None:
+            if accelerations is not None and name in accelerations:
+                rates[name] = np.broadcast_to(np.asarray(accelerations[name], dtype=float), (rec.n,))
+            elif len(name) == 1 or differentiate is None:
                 rates[name] = rec.channel(name)
             else:
                 rates[name] = differentiate(rate(name[0]), rec.dt)

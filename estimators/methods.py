@@ -29,7 +29,8 @@ class Estimator(Protocol):
 
 def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None = None,
                    frequencies_hz: tuple[float, ...] | str | None = None, detrend: str = "lstsq",
-                   data: DataOptions = DataOptions(), model: str | None = None) -> Estimator:
+                   data: DataOptions = DataOptions(), model: str | None = None,
+                   acceleration: str = "time", hold: tuple[str, ...] = ()) -> Estimator:
     """The estimator called ``name`` (one of :data:`REGISTRY`).
 
     ``errors`` applies to the time-domain equation-error methods; ``None`` is the method's
@@ -40,7 +41,10 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
     seed's rule (2/T to 1.2 Hz by 0.04 Hz) and a least-squares line;
     ``**SIDPAC_FREQUENCY_OPTIONS`` (``frequencies_hz='sidpac'``, ``detrend='endpoints'``)
     gives SIDPAC's Eq. 18 band and end-point line. ``model`` names the output-error family's
-    built-in model (None: chosen from the equation fitted).
+    built-in model (None: chosen from the equation fitted). ``acceleration`` and ``hold`` are
+    ``ee-freq``'s options for moment equations whose angular accelerations are differentiated
+    from the rates and whose inputs are steps on sample instants (see
+    :class:`estimators.equation_error.EquationErrorFrequency`; not the defaults).
     """
     info = method_info(name)
     if errors == "colored" and not info.supports("colored"):
@@ -52,7 +56,8 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
     if name == "ee-smooth":
         return EquationErrorTime(errors=errors, max_lag=max_lag, smooth_regressors=True, data=data)
     if name == "ee-freq":
-        return EquationErrorFrequency(frequencies_hz=frequencies_hz, detrend=detrend, data=data)
+        return EquationErrorFrequency(frequencies_hz=frequencies_hz, detrend=detrend, data=data,
+                                      acceleration=acceleration, hold=tuple(hold))
     if name == "oe":
         from estimators.output_error import OutputError
         return OutputError(model=model, data=data)

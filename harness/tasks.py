@@ -79,6 +79,8 @@ def estimator_options(task: Task, method: str) -> dict:
         out["detrend"] = str(opts["detrend"])
     if "max_lag" in opts:
         out["max_lag"] = int(opts["max_lag"])
+    if "hold" in opts:
+        out["hold"] = tuple(str(h) for h in opts["hold"])
     return out
 
 

@@ -293,6 +293,7 @@ BASE = 'name = "t"\nseed = 1\nrealizations = 2\n'
     (BASE + '[grid]\naircraft = ["f61"]\n', ("aircraft 'f61'", "did you mean 'f16'")),
     (BASE + '[grid]\nmaneuver = ["2-1-1-3"]\n', ("kind '2-1-1-3'",)),
     (BASE + '[grid]\nmethod = ["ee-freq"]\n[method_options.ee-freq]\nfrequencies = "abc"\n', ("frequencies",)),
+    (BASE + '[grid]\nmethod = ["ee-freq"]\n[method_options.ee-freq]\nhold = "de"\n', ("hold", "regressor names")),
     (BASE + '[grid]\nmethod = ["ee-freq"]\n[method_factories]\n"ee-freq" = "os:system"\n',
      ("is code", "[plugins] allow")),
 ])
@@ -302,6 +303,16 @@ def test_campaign_file_mistakes_are_refused_before_anything_is_written(tmp_path,
     out = tmp_path / "out"
     _refused(capsys, ["campaign", str(path), "--out", str(out), "--quiet"], str(path), *needles, folder=tmp_path)
     assert not out.exists()
+
+
+def test_ee_freq_hold_reaches_the_estimator(tmp_path):
+    """``[method_options.ee-freq] hold = [...]`` becomes make_estimator's ``hold``."""
+    from harness.campaign import load_campaign
+    from harness.tasks import _estimator
+    (tmp_path / "c.toml").write_text(BASE + '[grid]\nmethod = ["ee-freq"]\n[method_options.ee-freq]\nhold = ["de"]\n')
+    campaign = load_campaign(tmp_path / "c.toml")
+    task = campaign.tasks()[0]
+    assert _estimator(task, "ee-freq", "conventional").hold == ("de",)
 
 
 def test_workers_zero_is_refused(tmp_path, capsys):

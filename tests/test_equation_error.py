@@ -274,3 +274,82 @@ def test_estimate_command_defaults_and_the_sidpac_options(tmp_path, shared_dir):
     assert main(base + ["--method", "ee-freq", "--frequencies", "sidpac", "--detrend", "endpoints",
                         "--json", str(out)]) == 0
     assert json.loads(out.read_text())["parameters"][0]["estimate"] == pytest.approx(0.083647, rel=5e-5)
+
+
+def test_derivative_transform_is_the_transform_of_the_detrended_derivative():
+    """Integration by parts (no smoothing) against the transform of the exact derivative's
+    samples, least-squares line removed: equal to the interpolation error."""
+    from estimators.equation_error import derivative_transform
+    from estimators.fourier import finite_fourier_transform
+    dt = 0.02
+    t = np.arange(1001) * dt
+    y = np.sin(2.1 * t + 0.3) + 0.01 * t**2 + 0.5 * np.exp(-0.3 * t)  # not at rest at either end
+    ydot = 2.1 * np.cos(2.1 * t + 0.3) + 0.02 * t - 0.15 * np.exp(-0.3 * t)
+    f = np.arange(0.1, 1.21, 0.04)
+    from estimators.equation_error import continuous_line
+    ref = finite_fourier_transform(ydot - continuous_line(ydot, dt), dt, f)
+    assert np.max(np.abs(derivative_transform(y, dt, f) - ref)) < 1e-6 * np.max(np.abs(ref))
+
+
+def _short_period_steps(dt=0.02, T=20.0):
+    """The seed's linear short period (Eq. 33 form) driven by a 2-1-1-2 whose steps fall on
+    samples, discretised exactly (the input is constant between samples): alpha, q, de and
+    the exact qdot at the samples (the sample at a step holding the new value)."""
+    from scipy.linalg import expm
+    A = np.array([[-1.2, 0.98], [-4.5, -1.6]])  # alpha, q
+    B = np.array([-0.12, -11.0])
+    n = round(T / dt) + 1
+    t = np.arange(n) * dt
+    u = np.where((t >= 1.0 - 1e-9) & (t < 3.0 - 1e-9), 1.0, 0.0) - np.where((t >= 3.0 - 1e-9) & (t < 4.0 - 1e-9), 1.0, 0.0)
+    u = u + np.where((t >= 4.0 - 1e-9) & (t < 5.0 - 1e-9), 1.0, 0.0) - np.where((t >= 5.0 - 1e-9) & (t < 7.0 - 1e-9), 1.0, 0.0)
+    u = np.radians(u)
+    M = expm(np.block([[A, B[:, None]], [np.zeros((1, 3))]]) * dt)
+    Phi, Gam = M[:2, :2], M[:2, 2]
+    x = np.zeros((n, 2))
+    for i in range(n - 1):
+        x[i + 1] = Phi @ x[i] + Gam * u[i]
+    xdot = x @ A.T + np.outer(u, B)
+    return t, x[:, 0], x[:, 1], u, xdot[:, 1], np.array([A[1, 0], A[1, 1], B[1]])
+
+
+def test_ee_freq_hold_removes_the_half_sample_bias_of_stepped_inputs():
+    """q̇ differentiated from q (continuous) responds to a step at its instant; the cubic
+    interpolant of the stepped de centres the jump half a sample early, and Eqs. 19-23 put
+    the phase error into M_q (several per cent, noise-free). Held de removes it; with the
+    sampled q̇ (jump sampled like de's) the default is exact and holding would be wrong."""
+    from estimators.differentiation import smooth_derivative
+    t, alpha, q, de, qdot, truth = _short_period_steps()
+    X = np.column_stack([alpha, q, de])
+
+    def err(z, **kw):
+        d = RegressionData.from_arrays(z, X, ("alpha", "q", "de"), 0.02, dependent="Cm", bias=False)
+        return np.asarray(EquationErrorFrequency(**kw).fit(d).params) / truth - 1
+
+    assert np.max(np.abs(err(qdot))) < 1e-9  # sampled q̇: exact by default
+    smoothed = smooth_derivative(q, 0.02, method=1)  # the seed's method 1, as for flight data
+    default, held = err(smoothed), err(smoothed, hold=("de",))
+    assert abs(default[1]) > 0.03  # M_q off by several per cent without any noise
+    assert np.max(np.abs(held)) < 0.01 and abs(held[1]) < 0.2 * abs(default[1])
+    force = RegressionData.from_arrays(qdot, X, ("alpha", "q", "de"), 0.02, dependent="CZ", bias=False)
+    assert EquationErrorFrequency(hold=("de",)).fit(force).info["hold"] == []  # force equations untouched
+
+
+def test_ee_freq_transform_and_hold_on_the_exact_truth_f16(three_axis_exact):
+    """JSBSim's exact-truth F-16 (no structure error, noise-free), pitch rate differentiated
+    by the seed's method 1 as in every noisy campaign: Cm_q̂ is biased by the default and
+    recovered by ``hold`` with ``acceleration='transform'``."""
+    from estimators.regressors import DataOptions
+    rec = three_axis_exact
+    eq = Equation("Cm", ("alpha", "qhat", "de"))
+    truth = np.array([rec.meta["truth"]["derivatives"][f"Cm_{r}"]["local"] for r in eq.regressors])
+    data = DataOptions(angular_acceleration="smooth-local")
+    default = np.asarray(EquationErrorFrequency(data=data).fit(rec, eq).params) / truth - 1
+    fit = EquationErrorFrequency(data=data, acceleration="transform", hold=("de",)).fit(rec, eq)
+    fixed = np.asarray(fit.params) / truth - 1
+    assert fit.info["acceleration"] == "transform" and fit.info["hold"] == ["de"]
+    assert default[1] < -0.05
+    assert abs(fixed[1]) < 0.002 and np.max(np.abs(fixed)) < 0.006
+    recorded = EquationErrorFrequency(acceleration="transform").fit(rec, eq)  # q̇ recorded: nothing to do
+    assert recorded.info["acceleration"] == "time"
+    with pytest.raises(Exception, match="lstsq"):
+        EquationErrorFrequency(acceleration="transform", detrend="endpoints")

@@ -169,3 +169,21 @@ def test_chirp_z_path_matches_direct_sum():
 def test_invalid_input(x, freqs):
     with pytest.raises(ValueError):
         finite_fourier_transform(x, DT, freqs)
+
+
+def test_held_transform_exact_for_steps_on_samples():
+    """A step on a sample instant, the sample holding the new value: the zero-order hold's
+    transform is the step's own, int_t1^T e^{-j w t} dt; the cubic interpolant's lags it by
+    half a sample in phase (its jump is centred at t1 - dt/2)."""
+    from estimators.fourier import held_fourier_transform
+    dt, t1, T = 0.02, 1.0, 4.0
+    t = np.arange(round(T / dt) + 1) * dt
+    x = (t >= t1 - 1e-12).astype(float)
+    f = np.array([0.0, 0.3, 1.1])
+    w = 2 * np.pi * f[1:]
+    exact = np.concatenate([[T - t1], (np.exp(-1j * w * t1) - np.exp(-1j * w * T)) / (1j * w)])
+    assert np.allclose(held_fourier_transform(x, dt, f), exact, rtol=0, atol=1e-13)
+    cubic = finite_fourier_transform(x, dt, f)
+    early = np.concatenate([[T - t1 + dt / 2], (np.exp(-1j * w * (t1 - dt / 2)) - np.exp(-1j * w * T)) / (1j * w)])
+    assert np.allclose(cubic, early, rtol=0, atol=1e-2 * dt)
+    assert np.max(np.abs(cubic - exact)) > 0.4 * dt
