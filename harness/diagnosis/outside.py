@@ -43,7 +43,7 @@ from scipy import signal
 from harness.atomic import write_text_atomic
 from harness.diagnosis.gallery import StructuralMode, conceal
 from harness.diagnosis.refine import validation_rms_pair
-from harness.diagnosis.sweep import run_resumable
+from harness.diagnosis.sweep import run_resumable, size_right, validation_drop
 from harness.noise import ChannelNoise, NoiseModel, apply_noise
 from harness.noise_presets import WHITE_LEVELS
 from harness.recording_io import write_recording
@@ -58,7 +58,6 @@ from models.hidden import HiddenEffect as H
 
 DEG = math.pi / 180.0
 EARTH_RATE_RPS = 7.292115e-5  # WGS-84, as JSBSim
-BAR_DROP = 0.30
 DURATION_S = 30.0
 SIGNIFICANT_DIGITS = 8
 
@@ -439,21 +438,10 @@ def score(c: OutsideCase, result: dict) -> dict:
         # a ``none`` on an effect is a miss (criterion a), not a false finding
         false = [f for f in findings if f["effect"] != "none" and _key(f) != (c.expect, c.parameter)]
         row["a"] = _key(first) == (c.expect, c.parameter)
-        estimate = first["evidence"].get("change", first["estimate"]) if c.expect == "coefficient_error" \
-            else first["estimate"]
-        row["b"] = None if not math.isfinite(c.truth) else bool(row["a"] and (
-            abs(estimate - c.truth) <= 2.0 * first["std_error"] or abs(estimate - c.truth) <= 0.25 * abs(c.truth)))
-        row["d"] = None
-        if c.channel:
-            row["d"] = False
-            if "validation" in first.get("fit_before", {}) and first["effect"] != "none":
-                before = first["fit_before"]["validation"]["outputs"].get(c.channel, {}).get("rms")
-                # d is scored on the equation-error sizes, as before the calibration step
-                ee = first.get("fit_after_equation_error") or first["fit_after"]
-                after = ee["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
-                if before and after is not None:
-                    row["validation_rms"] = [before, after]
-                    row["d"] = bool(row["a"] and 1.0 - after / before >= BAR_DROP)
+        row["b"] = size_right(first, c.expect, c.truth, row["a"])
+        row["d"], rms = validation_drop(first, c.channel, row["a"])
+        if rms is not None:
+            row["validation_rms"] = rms
     # the calibration step's column: the affected output's validation RMS after the
     # equation-error and after the calibrated sizes, and which the diagnosis kept
     row["calibration"] = validation_rms_pair(result.get("calibration") or {}, c.channel)

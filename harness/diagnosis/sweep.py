@@ -154,23 +154,40 @@ def score(c: SweepCase, result: dict) -> dict:
         row.update(a=first["effect"] == "none", b=None, c=first["effect"] == "none", d=None)
         return row
     row["a"] = first["effect"] == c.expect and first["parameter"] == c.parameter
-    estimate = first["evidence"].get("change", first["estimate"]) if c.expect == "coefficient_error" \
-        else first["estimate"]
-    row["b"] = None if not math.isfinite(c.truth) else bool(row["a"] and (
-        abs(estimate - c.truth) <= 2.0 * first["std_error"] or abs(estimate - c.truth) <= 0.25 * abs(c.truth)))
+    row["b"] = size_right(first, c.expect, c.truth, row["a"])
     row["c"] = None
-    row["d"] = None
-    if c.channel and "validation" in first.get("fit_before", {}) and first["effect"] != "none":
-        before = first["fit_before"]["validation"]["outputs"].get(c.channel, {}).get("rms")
-        # d is scored on the equation-error sizes, as before the calibration step
-        ee = first.get("fit_after_equation_error") or first["fit_after"]
-        after = ee["validation"].get("outputs", {}).get(c.channel, {}).get("rms")
-        if before and after is not None:
-            row["validation_rms"] = [before, after]
-            row["d"] = bool(row["a"] and 1.0 - after / before >= BAR_DROP)
-    elif c.channel:
-        row["d"] = False
+    row["d"], rms = validation_drop(first, c.channel, row["a"])
+    if rms is not None:
+        row["validation_rms"] = rms
     return row
+
+
+def size_right(first: dict, expect: str, truth: float, named: bool) -> bool | None:
+    """Criterion b: the first finding, when it is the right one (``named``), has its size
+    within 2 standard errors or 25 % of the truth (a coefficient error by its change);
+    None when the truth has no size."""
+    if not math.isfinite(truth):
+        return None
+    estimate = first["evidence"].get("change", first["estimate"]) if expect == "coefficient_error" \
+        else first["estimate"]
+    err = abs(estimate - truth)
+    return bool(named and (err <= 2.0 * first["std_error"] or err <= 0.25 * abs(truth)))
+
+
+def validation_drop(first: dict, channel: str | None, named: bool) -> tuple[bool | None, list | None]:
+    """Criterion d: the validation RMS of the affected ``channel`` drops by at least
+    :data:`BAR_DROP` with the equation-error sizes (as before the calibration step), for the
+    right finding; with the (before, after) RMS pair. None when no channel is scored."""
+    if not channel:
+        return None, None
+    if "validation" not in first.get("fit_before", {}) or first["effect"] == "none":
+        return False, None
+    before = first["fit_before"]["validation"]["outputs"].get(channel, {}).get("rms")
+    ee = first.get("fit_after_equation_error") or first["fit_after"]
+    after = ee["validation"].get("outputs", {}).get(channel, {}).get("rms")
+    if not before or after is None:
+        return False, None
+    return bool(named and 1.0 - after / before >= BAR_DROP), [before, after]
 
 
 def run_case(c: SweepCase, out: Path) -> dict:
