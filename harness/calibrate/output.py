@@ -9,10 +9,9 @@ import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from harness.atomic import ensure_folder, write_atomic, write_text_atomic
+from harness.atomic import ensure_folder, jsonable, write_atomic, write_text_atomic
 from harness.calibrate.run import CalibrationResult
 from models.aircraft import new_fdm
 from models.jsbsim_root import write_root
@@ -41,19 +40,6 @@ def fly_stock(tree: ET.ElementTree, source: Path, name: str, h_ft: float, V_fps:
             "(FCS enabled, the aircraft's own systems and the calibration's actuator delays running)"}
 
 
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (float, np.floating)):
-        v = float(x)
-        return v if math.isfinite(v) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
 
 
 def write_calibration(result: CalibrationResult, out: str | Path) -> dict:
@@ -80,6 +66,6 @@ def write_calibration(result: CalibrationResult, out: str | Path) -> dict:
                     "engines_and_systems": f"those of {result.base.source} (linked, not copied)", "stock_check": stock,
                     "delays": "JSBSim <actuator> delays in a <system> of their own (rounded down to whole frames)"}
     doc["series"] = files
-    doc = _jsonable(doc)
+    doc = jsonable(doc)
     write_text_atomic(out / "calibration.json", json.dumps(doc, indent=1))
     return doc

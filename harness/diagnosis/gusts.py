@@ -43,7 +43,7 @@ def process_noise_model(p: Prepared) -> dict:
     ln_s, ln_tau = float(fe.params["ln_sigma_gust"]), float(fe.params["ln_tau_gust"])
     se_ln = float(fe.bse["ln_sigma_gust"])
     sigma = V * np.exp(ln_s)
-    outputs = list(fe.dependent) if isinstance(fe.dependent, (list, tuple)) else ["alpha", "q", "az"]
+    outputs = fe.dependent.split(",")  # the model's outputs, in the residuals' column order
     before = {o: _rms(oe.residuals[:, i]) for i, o in enumerate(outputs)}
     after = {o: _rms(fe.residuals[:, i]) for i, o in enumerate(outputs)}
     return {"fitted": True, "method": "filter error (fe), short-period model with a first-order gust on alpha",

@@ -25,7 +25,7 @@ choice is a coin toss the report must not present as a finding. Two kinds of riv
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,5 +128,3 @@ def bias_rival(z: np.ndarray, term_column: np.ndarray, others: list[np.ndarray],
     bias = -_coefficient(z, others, slope)
     return BiasRival(channel, bias, t_term, float(kinematic[0]), float(kinematic[1]))
 
-
-SlopeFn = Callable[[str], Mapping[str, np.ndarray]]

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 from scipy import signal
 
-from harness.atomic import write_atomic, write_text_atomic
+from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import refine
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
@@ -821,7 +821,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     (out / "series").mkdir(parents=True, exist_ok=True)
     for name, df in series.items():
         write_atomic(out / "series" / f"{name}.parquet", lambda fh, df=df: df.to_parquet(fh, index=False))
-    write_text_atomic(out / "findings.json", json.dumps(_jsonable(result), indent=1))
+    write_text_atomic(out / "findings.json", json.dumps(jsonable(result), indent=1))
     return result
 
 
@@ -889,16 +889,3 @@ def _write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, .
                      "drives; the aerodynamic terms fly in any JSBSim")}
 
 
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        v = float(x)
-        return v if np.isfinite(v) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
