@@ -10,6 +10,7 @@ from harness.diagnosis import candidates as cand
 from harness.diagnosis import rivals
 from harness.diagnosis.gusts import process_noise_model
 from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
                                           is_plausible, is_practical, kinematic_check, kinematic_residuals)
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
@@ -358,8 +359,11 @@ def _withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch
             if not c.selected or c.channel != axis or key is None:
                 continue
             others = [by_key[k].column[inner] for k in chosen if k != key]
-            theta, se, _ = colored_fit(z, others + [by_key[key].column[inner]], [f"o{i}" for i in range(len(others))]
-                                       + [key])
+            try:
+                theta, se, _ = colored_fit(z, others + [by_key[key].column[inner]],
+                                           [f"o{i}" for i in range(len(others))] + [key])
+            except (SingularRegressorsError, np.linalg.LinAlgError):
+                continue  # the term's column is dependent on the others: nothing to re-test
             t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
             if abs(t) < cand.T_IN:
                 c.selected = False
