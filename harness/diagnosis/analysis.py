@@ -3,11 +3,12 @@ candidate test, gathered into scored candidates."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from harness.diagnosis import candidates as cand
-from harness.diagnosis import rivals
+from harness.diagnosis import corroborate, rivals
 from harness.diagnosis.gusts import process_noise_model
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
@@ -87,11 +88,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     cands = _kinematic_candidates(kin, p, turbulent, plausible)
     p = _corrected(p, kin, sensor_values)
     # 2. the model along the measured states
-    states, surfaces = model_states(p)
-    alphadot = p.deriv["alpha"] if "alpha" in p.driven else None
-    aero = aero_along(aircraft, ic, states, surfaces, alphadot)
-    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
-    mismatch = {c: measured[c] - aero.coefficients[c] for c in COEFFICIENTS}
+    along = model_along(p, aircraft, ic)
+    states, surfaces, alphadot, aero, measured = along
+    mismatch = along.mismatch()
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
     off, off_candidate = _offset_candidate(p, mismatch, noise, measured)
@@ -107,6 +106,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     _withhold_ambiguous(cands, kin)
     if turbulent:
         _withhold_in_turbulence(cands)
+    elif plausible:
+        _name_corroborated(cands, kin, p, aircraft, ic, mismatch, step, set(sensor_values), V0)
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += _spectral_candidates(peak, gust, turbulent)
@@ -213,6 +214,28 @@ def model_states(p: Prepared) -> tuple[dict[str, np.ndarray], dict[str, np.ndarr
     if p.altitude is not None:
         states["h"] = p.altitude
     return states, surfaces
+
+
+class ModelAlong(NamedTuple):
+    """The model evaluated along a recording's states (seed Eqs. 1-5 on both sides)."""
+
+    states: dict[str, np.ndarray]
+    surfaces: dict[str, np.ndarray]
+    alphadot: np.ndarray | None
+    aero: AeroAlong
+    measured: dict[str, np.ndarray]
+
+    def mismatch(self) -> dict[str, np.ndarray]:
+        return {c: self.measured[c] - self.aero.coefficients[c] for c in COEFFICIENTS}
+
+
+def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> ModelAlong:
+    """The measured coefficients and the model's along the states of :func:`model_states`."""
+    states, surfaces = model_states(p)
+    alphadot = p.deriv["alpha"] if "alpha" in p.driven else None
+    aero = aero_along(aircraft, ic, states, surfaces, alphadot)
+    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
+    return ModelAlong(states, surfaces, alphadot, aero, measured)
 
 
 def _inner(p: Prepared) -> slice:
@@ -433,6 +456,7 @@ def _withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, 
             if (b is not None and abs(b.t_term) < cand.T_IN and not b.ruled_out
                     and is_plausible(f"bias_{x}", b.bias_rad, V0)):
                 c.selected = False
+                c.details["sensor_rival"] = f"bias_{x}"
                 c.reason = (f"entered, but not named: a {x} vane bias of {np.degrees(b.bias_rad):.2f} deg would "
                             f"imitate it through the model's nonlinearity (beside it, t = {b.t_term:.1f}), and the "
                             f"kinematics cannot rule that bias out ({_bias_text(b)})")
@@ -507,6 +531,7 @@ def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
     close = abs(skew - c.estimate) <= max(2.0 * c.std_error, 0.3 * abs(c.estimate))
     if t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and close:
         c.selected = False
+        c.details["sensor_rival"] = name
         c.reason = (f"entered, but not named: the kinematics show the {SURFACE_RATE[c.channel]} channel lagging by "
                     f"{skew:.3f} s ({name}, t = {t:.1f}), which looks like this delay")
 
@@ -530,6 +555,7 @@ def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
         if channel in suspects:
             rival, t = suspects[channel]
             c.selected = False
+            c.details["sensor_rival"] = rival
             c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({rival}, "
                         f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
     for c in cands:  # the sensor the coefficient itself is measured with
@@ -541,8 +567,53 @@ def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
         if rival.startswith("skew") and not (c.effect == "unsteady_alphadot" or rate_term):
             continue  # a lag imitates terms that follow the coefficient's rate of change, not its level
         c.selected = False
+        c.details["sensor_rival"] = rival
         c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
                     f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
+
+
+def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                       ic: InitialCondition, mismatch: dict[str, np.ndarray], step: _Stepwise, applied: set[str],
+                       V0: float) -> None:
+    """Name a suspected sensor error (kinematic |t| >= :data:`AMBIGUOUS_T`, below the kinematic
+    entry t) that kept a coefficient term from being named, when the coefficient mismatch
+    independently shows the same error on every axis that can tell (:mod:`corroborate`). Its
+    signature is the change in the mismatch when the channels are corrected by the kinematic
+    estimate and the model is evaluated again."""
+    inner = _inner(p)
+    suspects = sorted({c.details["sensor_rival"] for c in cands if not c.selected and "sensor_rival" in c.details})
+    for name in suspects:
+        sensor = next((c for c in cands if c.parameter == name), None)
+        found = _kin_estimate(kin, name)
+        if sensor is None or sensor.selected or found is None or name in applied:
+            continue
+        v, t = found
+        if t < AMBIGUOUS_T or not is_plausible(name, v, V0):
+            continue
+        changed = model_along(_corrected(p, kin, {name: v}), aircraft, ic).mismatch()
+        ratios = {}
+        for axis, (sel, by_key) in step.selections.items():
+            kept = {c.parameter for c in cands if c.selected and c.channel == axis}
+            others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
+            others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
+            r = corroborate.axis_ratio(mismatch[axis][inner], others, (changed[axis] - mismatch[axis])[inner])
+            if r is not None:
+                ratios[axis] = r
+        verdict = corroborate.corroborate(name, v, abs(v) / t, ratios, t_aero=cand.T_IN)
+        sensor.details["corroboration"] = verdict.as_dict()
+        practical = (is_practical(name, verdict.estimate, p.dt)
+                     and _kin_share(kin, name, verdict.estimate, p) >= cand.PRACTICAL_SHARE)
+        if not (verdict.named and practical):
+            continue
+        sensor.selected = True
+        sensor.estimate, sensor.std_error = verdict.estimate, verdict.std_error
+        sensor.t = verdict.estimate / verdict.std_error
+        sensor.reason = verdict.reason + f" (kinematic t = {t:.1f}, below their entry t alone)"
+        for c in cands:
+            if c.details.get("sensor_rival") == name:
+                c.reason += f"; explained by the {name} named"
+
+
 KINEMATIC_PASSES = 4
 
 

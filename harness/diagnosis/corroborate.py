@@ -1,0 +1,122 @@
+"""Corroborated sensor errors: one instrument error seen by two independent tests.
+
+The kinematic check names a sensor error on its own only at |t| >= its entry t
+(:data:`harness.diagnosis.kinematics.T_IN`, 6). Below that, a scale, lag or vane error it
+merely *suspects* already keeps the coefficient terms it would imitate from being named
+(``analysis._withhold_ambiguous``, the vane-bias rival of :mod:`rivals`). The coefficient
+mismatch is then a second, independent test of the same instrument error: the model's
+aerodynamics are evaluated along the recorded states (seed Eqs. 1-5), so a sensor error
+leaves a definite signature on *every* axis.
+
+The signature is computed, not assumed: the channels are corrected by the kinematic
+estimate ``v`` (the sensor's own correction), the model is evaluated again along them,
+and the mismatch changes by ``Δ_C(t)`` on each axis ``C``. If the instrument is in error by
+``a·v`` the mismatch carries ``-a·Δ_C(t)``, so a fit of each axis's mismatch on ``-Δ_C``
+(beside the axis's other named terms, with a constant; colored-residual standard errors,
+seed Eq. 39) gives ``a_C ± σ_C``. The error is named when
+
+* the axes that can tell (``σ_C`` at most :data:`INFORMATIVE_SE`) agree with one ratio
+  ``â`` (each within :data:`AGREE_Z` of its standard errors, or :data:`AGREE_FRACTION`),
+  which a single coefficient error cannot do: a wrong C_Z,α moves C_Z alone, a wrong α
+  vane moves C_Z, C_m and C_X by the model's own slopes;
+* the aerodynamic evidence is significant on its own (``â/σ_â`` at least the aerodynamic
+  entry t);
+* it agrees with the kinematic estimate (``|â - 1|`` within :data:`AGREE_Z` of the
+  combined standard error).
+
+The size named is the inverse-variance mean of the two estimates.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
+
+# An axis takes part when it determines the ratio to within ±100 % (one standard error).
+INFORMATIVE_SE = 1.0
+# Agreement: within this many standard errors ...
+AGREE_Z = 3.0
+# ... or this fraction of the common ratio (the model's slopes carry their own small errors).
+AGREE_FRACTION = 0.3
+
+
+@dataclass(frozen=True)
+class AxisRatio:
+    """One axis's estimate of the sensor error, as a multiple of the kinematic estimate."""
+
+    axis: str
+    ratio: float
+    std_error: float
+
+
+@dataclass(frozen=True)
+class Corroboration:
+    """The aerodynamic test of a suspected sensor error, and its verdict."""
+
+    name: str
+    kinematic: float
+    kinematic_std: float
+    axes: tuple[AxisRatio, ...]
+    ratio: float              # â, the informative axes' common ratio
+    ratio_std: float
+    named: bool
+    reason: str
+    estimate: float           # the combined size (the kinematic one when not named)
+    std_error: float
+
+    def as_dict(self) -> dict:
+        return {"kinematic": self.kinematic, "kinematic_std": self.kinematic_std,
+                "aerodynamic": self.ratio * self.kinematic, "aerodynamic_std": abs(self.ratio_std * self.kinematic),
+                "axes": {a.axis: {"ratio": a.ratio, "std_error": a.std_error} for a in self.axes},
+                "named": self.named, "reason": self.reason}
+
+
+def axis_ratio(z: np.ndarray, others: list[np.ndarray], signature: np.ndarray) -> AxisRatio | None:
+    """``a ± σ`` of ``z ≈ others·θ - a·signature + c`` (colored-residual standard error);
+    None when the signature is flat or dependent on the others."""
+    if np.ptp(signature) <= 0:
+        return None
+    try:
+        theta, se, _ = colored_fit(z, others + [-signature], [f"o{i}" for i in range(len(others))] + ["a"])
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return None
+    j = len(others)
+    return AxisRatio("", float(theta[j]), float(se[j]) if se[j] > 0 else np.inf)
+
+
+def corroborate(name: str, kinematic: float, kinematic_std: float, ratios: dict[str, AxisRatio], *,
+                t_aero: float) -> Corroboration:
+    """The verdict on a suspected sensor error (module docstring); ``ratios`` per axis from
+    :func:`axis_ratio`, ``t_aero`` the aerodynamic entry t."""
+    axes = tuple(AxisRatio(k, r.ratio, r.std_error) for k, r in sorted(ratios.items())
+                 if np.isfinite(r.std_error) and r.std_error <= INFORMATIVE_SE)
+
+    def verdict(named: bool, reason: str, a=np.nan, sa=np.inf, est=kinematic, se=kinematic_std):
+        return Corroboration(name, kinematic, kinematic_std, axes, float(a), float(sa), named, reason,
+                             float(est), float(se))
+
+    if not axes:
+        return verdict(False, "no axis of the coefficient mismatch can tell this sensor error")
+    w = np.array([1.0 / a.std_error ** 2 for a in axes])
+    r = np.array([a.ratio for a in axes])
+    a_hat = float(np.sum(w * r) / np.sum(w))
+    sa = float(1.0 / np.sqrt(np.sum(w)))
+    apart = [a for a in axes if abs(a.ratio - a_hat) > max(AGREE_Z * a.std_error, AGREE_FRACTION * abs(a_hat))]
+    if apart:
+        return verdict(False, "the coefficient axes disagree on it ("
+                       + ", ".join(f"{a.axis} {a.ratio:.2f} ± {a.std_error:.2f}" for a in axes)
+                       + " of the kinematic size): a coefficient error on one axis, not an instrument", a_hat, sa)
+    if a_hat / sa < t_aero:
+        return verdict(False, f"the coefficient mismatch does not show it clearly (t = {a_hat / sa:.1f})", a_hat, sa)
+    rel_kin = abs(kinematic_std / kinematic) if kinematic != 0 else np.inf
+    if abs(a_hat - 1.0) > AGREE_Z * np.hypot(sa, rel_kin):
+        return verdict(False, f"the coefficient mismatch asks for {a_hat:.2f} ± {sa:.2f} times the kinematic "
+                       "size", a_hat, sa)
+    v_aero, s_aero = a_hat * kinematic, abs(sa * kinematic)
+    wk, wa = 1.0 / kinematic_std ** 2, 1.0 / s_aero ** 2
+    est = (wk * kinematic + wa * v_aero) / (wk + wa)
+    return verdict(True, "named on two independent tests: the kinematics and the coefficient mismatch ("
+                   + ", ".join(a.axis for a in axes) + ") agree on it", a_hat, sa, est, 1.0 / np.sqrt(wk + wa))

@@ -1,0 +1,49 @@
+"""Corroborated sensor errors (harness.diagnosis.corroborate): the ratio fit is exact on
+noise-free data, and the verdict follows its three rules."""
+import numpy as np
+import pytest
+
+from harness.diagnosis.corroborate import AxisRatio, axis_ratio, corroborate
+
+
+def test_axis_ratio_recovers_the_multiple_of_the_signature_exactly():
+    t = np.linspace(0.0, 10.0, 501)
+    signature = np.sin(1.3 * t) + 0.2 * t
+    other = np.cos(0.7 * t)
+    z = 0.4 * other - 0.8 * signature + 0.05
+    r = axis_ratio(z, [other], signature)
+    assert r.ratio == pytest.approx(0.8, abs=1e-10)
+
+
+def test_axis_ratio_is_none_for_a_flat_signature():
+    assert axis_ratio(np.ones(50), [], np.zeros(50)) is None
+
+
+def _r(a, s):
+    return AxisRatio("", a, s)
+
+
+def test_agreeing_axes_and_kinematics_name_the_sensor_with_the_pooled_size():
+    v = corroborate("bias_alpha", 0.03, 0.01, {"CZ": _r(1.0, 0.1), "Cm": _r(0.9, 0.05)}, t_aero=5.0)
+    assert v.named
+    a_hat = (1.0 / 0.01 + 0.9 / 0.0025) / (1 / 0.01 + 1 / 0.0025)
+    assert v.ratio == pytest.approx(a_hat)
+    s_aero = 0.03 * np.sqrt(1.0 / (1 / 0.01 + 1 / 0.0025))
+    w_k, w_a = 1 / 0.01 ** 2, 1 / s_aero ** 2
+    assert v.estimate == pytest.approx((w_k * 0.03 + w_a * a_hat * 0.03) / (w_k + w_a))
+
+
+def test_an_axis_that_disagrees_means_a_coefficient_error_not_an_instrument():
+    v = corroborate("scale_alpha", 0.1, 0.02, {"CZ": _r(1.0, 0.05), "Cm": _r(0.0, 0.05)}, t_aero=5.0)
+    assert not v.named and "disagree" in v.reason
+
+
+def test_uninformative_axes_do_not_vote_and_weak_evidence_is_not_named():
+    assert not corroborate("skew_q", 0.04, 0.01, {"Cm": _r(1.0, 3.0)}, t_aero=5.0).named
+    v = corroborate("skew_q", 0.04, 0.01, {"Cm": _r(1.0, 0.4)}, t_aero=5.0)
+    assert not v.named and "does not show it clearly" in v.reason
+
+
+def test_a_size_far_from_the_kinematic_one_is_not_named():
+    v = corroborate("skew_q", 0.04, 0.004, {"Cm": _r(2.0, 0.05)}, t_aero=5.0)
+    assert not v.named and "times the kinematic size" in v.reason
