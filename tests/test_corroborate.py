@@ -47,3 +47,41 @@ def test_uninformative_axes_do_not_vote_and_weak_evidence_is_not_named():
 def test_a_size_far_from_the_kinematic_one_is_not_named():
     v = corroborate("skew_q", 0.04, 0.004, {"Cm": _r(2.0, 0.05)}, t_aero=5.0)
     assert not v.named and "times the kinematic size" in v.reason
+
+
+def test_a_vane_scale_imitates_when_every_axis_that_can_tell_agrees():
+    from harness.diagnosis.corroborate import imitates
+    ag = imitates({"CZ": _r(3.0, 0.5), "Cm": _r(4.9, 1.6), "Cn": _r(-30.0, 40.0)}, t_aero=5.0)
+    assert ag is not None and {a.axis for a in ag.axes} == {"CZ", "Cm"}
+    # C_m says the vane scale is not there: a C_Z,α error, not the vane
+    assert imitates({"CZ": _r(3.0, 0.5), "Cm": _r(0.0, 0.2)}, t_aero=5.0) is None
+    # one axis alone cannot tell the two apart; nor can a weak signature
+    assert imitates({"CZ": _r(3.0, 0.5), "Cm": _r(4.9, 40.0)}, t_aero=5.0) is None
+    assert imitates({"CZ": _r(1.0, 0.5), "Cm": _r(1.0, 0.5)}, t_aero=5.0) is None
+
+
+def test_inertial_angles_recover_alpha_without_the_vanes_wander():
+    """A pitch-plane flight built from its kinematics (seed Eq. 1's w equation): the angle
+    integrated from a_z, q and θ equals α to integration accuracy, and a slow wander added to
+    the vane reading does not reach it beyond the constant and trend it is placed by."""
+    from types import SimpleNamespace
+    from harness.diagnosis.kinematics import inertial_angles
+    from models.constants import G0_FPS2 as g
+    dt, n = 0.01, 2001
+    t = np.arange(n) * dt
+    V = np.full(n, 500.0)
+    alpha = 0.05 + 0.02 * np.sin(1.7 * t)
+    theta = 0.05 + 0.03 * np.sin(0.9 * t)
+    q = 0.03 * 0.9 * np.cos(0.9 * t)
+    u, w = V * np.cos(alpha), V * np.sin(alpha)
+    w_dot = V * np.cos(alpha) * 0.02 * 1.7 * np.cos(1.7 * t)
+    az = (w_dot - q * u - g * np.cos(theta)) / g
+    z = np.zeros(n)
+    ch = {"V": V, "alpha": alpha, "beta": z, "p": z, "q": q, "r": z, "phi": z, "theta": theta, "ay": z, "az": az}
+    p = SimpleNamespace(dt=dt)
+    assert np.max(np.abs(inertial_angles(ch, p)["alpha"] - alpha)) < 1e-6
+    wander = 0.0017 * np.sin(0.4 * t + 1.0)  # 0.1 deg, in the maneuver's band
+    got = inertial_angles(ch | {"alpha": alpha + wander}, p)["alpha"]
+    A = np.column_stack([np.ones(n), t])
+    placed = wander - A @ np.linalg.lstsq(A, wander, rcond=None)[0]
+    assert np.std(got - alpha) < 0.25 * np.std(placed)

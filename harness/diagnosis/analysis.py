@@ -61,6 +61,7 @@ class Analysis:
     gust: object
     peak: object
     not_offered: dict = field(default_factory=dict)  # per axis: candidate parameters the maneuver did not excite
+    applied: dict = field(default_factory=dict)      # sensor corrections applied before the model was evaluated
 
 
 def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
@@ -106,8 +107,11 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     _withhold_ambiguous(cands, kin)
     if turbulent:
         _withhold_in_turbulence(cands)
-    elif plausible:
-        _name_corroborated(cands, kin, p, aircraft, ic, mismatch, step, set(sensor_values), V0)
+    else:
+        signature = _signature_ratios(cands, kin, p, aircraft, ic, mismatch, step)
+        _withhold_vane_scale(cands, kin, step, signature)
+        if plausible:
+            _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += _spectral_candidates(peak, gust, turbulent)
@@ -115,7 +119,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         next(c for c in cands if c.effect == "turbulence").details["process_noise_model"] = process_noise_model(p)
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
                     selections=step.selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
-                    not_offered=step.not_offered)
+                    not_offered=step.not_offered, applied=dict(sensor_values))
 
 
 def _turbulence(p: Prepared):
@@ -572,15 +576,65 @@ def _withhold_ambiguous(cands: list[Candidate], kin: KinematicResult) -> None:
                     f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
 
 
-def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
-                       ic: InitialCondition, mismatch: dict[str, np.ndarray], step: _Stepwise, applied: set[str],
+def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                      ic: InitialCondition, mismatch: dict[str, np.ndarray], step: _Stepwise):
+    """``ratios(name, value, skip)``: per axis, the multiple of the mismatch change that
+    correcting the channels by sensor parameter ``name`` = ``value`` makes (the model evaluated
+    again along the corrected channels, :mod:`corroborate`), fitted beside the axis's named
+    terms whose parameter is not in ``skip`` (and its nuisances)."""
+    inner = _inner(p)
+
+    def ratios(name: str, value: float, skip: frozenset[str] = frozenset()) -> dict:
+        changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic).mismatch()
+        out = {}
+        for axis, (sel, by_key) in step.selections.items():
+            kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
+            others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
+            others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
+            r = corroborate.axis_ratio(mismatch[axis][inner], others, (changed[axis] - mismatch[axis])[inner])
+            if r is not None:
+                out[axis] = r
+        return out
+    return ratios
+
+
+# The vane scale factor at which its signature is evaluated (the fit scales it).
+PROBE_SCALE = 0.05
+
+
+def _withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: _Stepwise, signature) -> None:
+    """Deselect coefficient errors on α or β that a scale error of that vane would imitate on
+    every axis that can tell (:func:`corroborate.imitates`): the model evaluated along a
+    scaled angle is off by each coefficient's own slope times the scaled excursion, so a
+    vane scale looks like C_Z,α, C_m,α and C_X,α wrong in the model's own proportions, which
+    no single coefficient error does. The kinematics cannot always see the scale (its
+    column is nearly a bias's when the angle hardly moves about its mean)."""
+    for x in ("alpha", "beta"):
+        name = f"scale_{x}"
+        chosen = [c for c in cands if c.selected and c.effect == "coefficient_error"
+                  and cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1]) == x]
+        if not chosen or name not in kin.parameters:
+            continue
+        same = frozenset(c.parameter for c in cands if c.parameter.endswith(f"_{x}") and c.test.startswith("stepwise"))
+        ag = corroborate.imitates(signature(name, PROBE_SCALE, same), t_aero=cand.T_IN)
+        if ag is None:
+            continue
+        for c in chosen:
+            c.selected = False
+            c.details["sensor_rival"] = name
+            each = ", ".join(f"{a.axis} {a.ratio * PROBE_SCALE:.3f} ± {a.std_error * PROBE_SCALE:.3f}" for a in ag.axes)
+            c.reason = (f"entered, but not named: an {x} vane scale error of k = {ag.ratio * PROBE_SCALE:.3f} would "
+                        f"explain the mismatch on every axis that can tell alike (k from {each}), in the model's own "
+                        "proportions, which a wrong derivative on one axis does not")
+
+
+def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature, applied: set[str],
                        V0: float) -> None:
     """Name a suspected sensor error (kinematic |t| >= :data:`AMBIGUOUS_T`, below the kinematic
     entry t) that kept a coefficient term from being named, when the coefficient mismatch
     independently shows the same error on every axis that can tell (:mod:`corroborate`). Its
     signature is the change in the mismatch when the channels are corrected by the kinematic
     estimate and the model is evaluated again."""
-    inner = _inner(p)
     suspects = sorted({c.details["sensor_rival"] for c in cands if not c.selected and "sensor_rival" in c.details})
     for name in suspects:
         sensor = next((c for c in cands if c.parameter == name), None)
@@ -590,16 +644,7 @@ def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared
         v, t = found
         if t < AMBIGUOUS_T or not is_plausible(name, v, V0):
             continue
-        changed = model_along(_corrected(p, kin, {name: v}), aircraft, ic).mismatch()
-        ratios = {}
-        for axis, (sel, by_key) in step.selections.items():
-            kept = {c.parameter for c in cands if c.selected and c.channel == axis}
-            others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
-            others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
-            r = corroborate.axis_ratio(mismatch[axis][inner], others, (changed[axis] - mismatch[axis])[inner])
-            if r is not None:
-                ratios[axis] = r
-        verdict = corroborate.corroborate(name, v, abs(v) / t, ratios, t_aero=cand.T_IN)
+        verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
         sensor.details["corroboration"] = verdict.as_dict()
         practical = (is_practical(name, verdict.estimate, p.dt)
                      and _kin_share(kin, name, verdict.estimate, p) >= cand.PRACTICAL_SHARE)

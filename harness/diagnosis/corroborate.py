@@ -87,28 +87,76 @@ def axis_ratio(z: np.ndarray, others: list[np.ndarray], signature: np.ndarray) -
     return AxisRatio("", float(theta[j]), float(se[j]) if se[j] > 0 else np.inf)
 
 
+@dataclass(frozen=True)
+class Agreement:
+    """The informative axes' common ratio ``â ± σ_â`` and the axes that depart from it."""
+
+    axes: tuple[AxisRatio, ...]
+    ratio: float
+    std_error: float
+    apart: tuple[AxisRatio, ...]
+
+    @property
+    def t(self) -> float:
+        return self.ratio / self.std_error if self.std_error > 0 else 0.0
+
+    def text(self) -> str:
+        return ", ".join(f"{a.axis} {a.ratio:.2f} ± {a.std_error:.2f}" for a in self.axes)
+
+
+def agreement(ratios: dict[str, AxisRatio]) -> Agreement | None:
+    """The axes that can tell (σ at most :data:`INFORMATIVE_SE`), their inverse-variance
+    common ratio, and those that depart from it by more than :data:`AGREE_Z` standard
+    errors and :data:`AGREE_FRACTION`; None when no axis can tell."""
+    axes = tuple(AxisRatio(k, r.ratio, r.std_error) for k, r in sorted(ratios.items())
+                 if np.isfinite(r.std_error) and r.std_error <= INFORMATIVE_SE)
+    if not axes:
+        return None
+    w = np.array([1.0 / a.std_error ** 2 for a in axes])
+    a_hat = float(np.sum(w * np.array([a.ratio for a in axes])) / np.sum(w))
+    apart = tuple(a for a in axes if abs(a.ratio - a_hat) > max(AGREE_Z * a.std_error, AGREE_FRACTION * abs(a_hat)))
+    return Agreement(axes, a_hat, float(1.0 / np.sqrt(np.sum(w))), apart)
+
+
+def imitates(ratios: dict[str, AxisRatio], *, t_aero: float) -> Agreement | None:
+    """The agreement when a sensor error explains the mismatch on at least two axes alike,
+    clearly (``t`` at least ``t_aero``): then a coefficient error on one of those axes
+    cannot be told from it by the coefficients alone. None otherwise.
+
+    The ratios are relative to a probe size; they are first put relative to the size all
+    axes together ask for (so that an axis counts as informative, :data:`INFORMATIVE_SE`,
+    when it can tell *that* size from zero), and the agreement is returned in probe units."""
+    finite = [r for r in ratios.values() if np.isfinite(r.std_error) and r.std_error > 0]
+    if not finite:
+        return None
+    w = np.array([1.0 / r.std_error ** 2 for r in finite])
+    a0 = float(np.sum(w * np.array([r.ratio for r in finite])) / np.sum(w))
+    if abs(a0) * np.sqrt(np.sum(w)) < t_aero:
+        return None
+    ag = agreement({k: AxisRatio(k, r.ratio / a0, r.std_error / abs(a0)) for k, r in ratios.items()})
+    if ag is None or len(ag.axes) < 2 or ag.apart:
+        return None
+    axes = tuple(AxisRatio(a.axis, a.ratio * a0, a.std_error * abs(a0)) for a in ag.axes)
+    return Agreement(axes, ag.ratio * a0, ag.std_error * abs(a0), ())
+
+
 def corroborate(name: str, kinematic: float, kinematic_std: float, ratios: dict[str, AxisRatio], *,
                 t_aero: float) -> Corroboration:
     """The verdict on a suspected sensor error (module docstring); ``ratios`` per axis from
     :func:`axis_ratio`, ``t_aero`` the aerodynamic entry t."""
-    axes = tuple(AxisRatio(k, r.ratio, r.std_error) for k, r in sorted(ratios.items())
-                 if np.isfinite(r.std_error) and r.std_error <= INFORMATIVE_SE)
+    ag = agreement(ratios)
+    axes = ag.axes if ag is not None else ()
 
     def verdict(named: bool, reason: str, a=np.nan, sa=np.inf, est=kinematic, se=kinematic_std):
         return Corroboration(name, kinematic, kinematic_std, axes, float(a), float(sa), named, reason,
                              float(est), float(se))
 
-    if not axes:
+    if ag is None:
         return verdict(False, "no axis of the coefficient mismatch can tell this sensor error")
-    w = np.array([1.0 / a.std_error ** 2 for a in axes])
-    r = np.array([a.ratio for a in axes])
-    a_hat = float(np.sum(w * r) / np.sum(w))
-    sa = float(1.0 / np.sqrt(np.sum(w)))
-    apart = [a for a in axes if abs(a.ratio - a_hat) > max(AGREE_Z * a.std_error, AGREE_FRACTION * abs(a_hat))]
-    if apart:
-        return verdict(False, "the coefficient axes disagree on it ("
-                       + ", ".join(f"{a.axis} {a.ratio:.2f} ± {a.std_error:.2f}" for a in axes)
-                       + " of the kinematic size): a coefficient error on one axis, not an instrument", a_hat, sa)
+    a_hat, sa = ag.ratio, ag.std_error
+    if ag.apart:
+        return verdict(False, f"the coefficient axes disagree on it ({ag.text()} of the kinematic size): a "
+                       "coefficient error on one axis, not an instrument", a_hat, sa)
     if a_hat / sa < t_aero:
         return verdict(False, f"the coefficient mismatch does not show it clearly (t = {a_hat / sa:.1f})", a_hat, sa)
     rel_kin = abs(kinematic_std / kinematic) if kinematic != 0 else np.inf

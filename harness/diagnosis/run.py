@@ -115,6 +115,23 @@ def _effect_of(c: Candidate) -> HiddenEffect | None:
     return None
 
 
+def _terms_of(findings: list[Candidate], applied: dict[str, float]) -> tuple[HiddenEffect, ...]:
+    """The model terms the findings add. A scale factor is estimated together with its
+    channel's bias (the kinematic fit always carries the bias); when that bias was applied to
+    the channels but is too small to be a finding itself, the scale's sensor model carries it
+    too (the recorded angle is (1 + k)·x + b, not (1 + k)·x)."""
+    out = []
+    for f in findings:
+        e = _effect_of(f)
+        if e is None:
+            continue
+        out.append(e)
+        bias = f"bias_{e.channel}"
+        if e.effect == "sensor_scale" and bias in applied and not any(g.parameter == bias for g in findings):
+            out.append(HiddenEffect("sensor_bias", float(applied[bias]), channel=e.channel))
+    return tuple(out)
+
+
 def _findings(analysis: Analysis) -> list[Candidate]:
     """The selected candidates, most significant first; turbulence, when named, leads: it is
     the broadband mismatch every deterministic term is then fitted against."""
@@ -764,7 +781,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"] != "confirmed"]
     findings = [f for f in findings if f not in unconfirmed]
     modelled = list(findings)
-    added = tuple(e for e in (_effect_of(f) for f in modelled) if e is not None)
+    added = _terms_of(modelled, a.applied)
     timing = {"analysis": time.perf_counter() - t0}
     # the recording as prepared (``a.prepared`` carries the sensor corrections; fits are
     # against what was recorded)
