@@ -87,13 +87,14 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     plausible = _kinematics_plausible(kin, V0)
     sensor_values = _sensor_values(kin, turbulent, plausible)
     cands = _kinematic_candidates(kin, p, turbulent, plausible)
-    p = _corrected(p, kin, sensor_values)
+    recorded, p = p, _corrected(p, kin, sensor_values)
     # 2. the model along the measured states
     along = model_along(p, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along
     mismatch = along.mismatch()
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
+    as_evaluated = dict(mismatch)
     off, off_candidate = _offset_candidate(p, mismatch, noise, measured)
     cands.append(off_candidate)
     # 4. delay scans; 5. per-axis stepwise
@@ -112,6 +113,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         _withhold_vane_scale(cands, kin, step, signature)
         if plausible:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
+            removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
+            _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += _spectral_candidates(peak, gust, turbulent)
@@ -645,18 +648,52 @@ def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared
         if t < AMBIGUOUS_T or not is_plausible(name, v, V0):
             continue
         verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
-        sensor.details["corroboration"] = verdict.as_dict()
-        practical = (is_practical(name, verdict.estimate, p.dt)
-                     and _kin_share(kin, name, verdict.estimate, p) >= cand.PRACTICAL_SHARE)
-        if not (verdict.named and practical):
+        if not _name_if_corroborated(sensor, kin, p, verdict, t):
             continue
-        sensor.selected = True
-        sensor.estimate, sensor.std_error = verdict.estimate, verdict.std_error
-        sensor.t = verdict.estimate / verdict.std_error
-        sensor.reason = verdict.reason + f" (kinematic t = {t:.1f}, below their entry t alone)"
         for c in cands:
             if c.details.get("sensor_rival") == name:
                 c.reason += f"; explained by the {name} named"
+
+
+def _name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepared, p: Prepared,
+                  aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
+                  removed: dict[str, np.ndarray], step: _Stepwise, applied: dict[str, float], V0: float) -> None:
+    """Name a sensor error that was applied to the channels (|t| >= :data:`APPLY_T`) but is
+    below its entry t, when the coefficient mismatch corroborates it (:mod:`corroborate`):
+    here the mismatch *without* the correction is fitted on the change the correction made
+    (a 1.5 deg α bias that the correction took out of a C_m,α-like mismatch at t = 18)."""
+    inner = _inner(p)
+    for name, v in applied.items():
+        sensor = next((c for c in cands if c.parameter == name), None)
+        if sensor is None or sensor.selected or sensor.reason != "below the entry t":
+            continue
+        without = _corrected(recorded, kin, {k: x for k, x in applied.items() if k != name})
+        base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic).mismatch().items()}
+        ratios = {}
+        for axis, (sel, by_key) in step.selections.items():
+            kept = {c.parameter for c in cands if c.selected and c.channel == axis}
+            others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
+            others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
+            r = corroborate.axis_ratio(base[axis][inner], others, (mismatch[axis] - base[axis])[inner])
+            if r is not None:
+                ratios[axis] = r
+        _name_if_corroborated(sensor, kin, p, corroborate.corroborate(name, v, abs(v) / _t_of(kin, name), ratios,
+                                                                      t_aero=cand.T_IN), _t_of(kin, name))
+
+
+def _name_if_corroborated(sensor: Candidate, kin: KinematicResult, p: Prepared, verdict, t_kin: float) -> bool:
+    """Select ``sensor`` at the verdict's combined size when the verdict names it and the size
+    is practical; the verdict is kept in ``details['corroboration']`` either way."""
+    sensor.details["corroboration"] = verdict.as_dict()
+    practical = (is_practical(sensor.parameter, verdict.estimate, p.dt)
+                 and _kin_share(kin, sensor.parameter, verdict.estimate, p) >= cand.PRACTICAL_SHARE)
+    if not (verdict.named and practical):
+        return False
+    sensor.selected = True
+    sensor.estimate, sensor.std_error = verdict.estimate, verdict.std_error
+    sensor.t = verdict.estimate / verdict.std_error
+    sensor.reason = verdict.reason + f" (kinematic t = {t_kin:.1f}, below their entry t alone)"
+    return True
 
 
 KINEMATIC_PASSES = 4

@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
+
 from models.hidden import AERO_TERMS, HiddenEffect
 
 # The output each term's coefficient (or delayed surface) drives most directly: the one the
@@ -114,6 +116,23 @@ def _rms(fits: dict, role: str, channel: str) -> float | None:
     return (((fits.get(role) or {}).get("outputs") or {}).get(channel) or {}).get("rms")
 
 
+# An output the terms do not drive may move a little when their sizes change (the replay's
+# trim moves with them); more than this fraction of its RMS error is a worse fit.
+UNJUDGED_TOLERANCE = 0.02
+
+
+def _raised_elsewhere(fits_ee: dict, fits_cal: dict, role: str, judged: list[str]) -> dict:
+    """The outputs besides ``judged`` whose ``role`` RMS error the calibrated sizes raise by
+    more than :data:`UNJUDGED_TOLERANCE`: {output: {"equation_error", "calibrated"}}."""
+    names = set((fits_ee.get(role) or {}).get("outputs") or {}) & set((fits_cal.get(role) or {}).get("outputs") or {})
+    out = {}
+    for o in sorted(names - set(judged)):
+        e, c = _rms(fits_ee, role, o), _rms(fits_cal, role, o)
+        if e is not None and c is not None and np.isfinite(e) and np.isfinite(c) and c > e * (1 + UNJUDGED_TOLERANCE):
+            out[o] = {"equation_error": e, "calibrated": c}
+    return out
+
+
 def decide(cal, fits_ee: dict, fits_cal: dict, outputs: list[str]) -> tuple[bool, str, dict]:
     """Whether the calibrated sizes are kept, why, and the figures compared.
 
@@ -155,6 +174,13 @@ def decide(cal, fits_ee: dict, fits_cal: dict, outputs: list[str]) -> tuple[bool
         detail = ", ".join(f"{o} {rms[o]['equation_error']:.4g} → {rms[o]['calibrated']:.4g}" for o in worse)
         return False, (f"the calibrated sizes fit the identification maneuver better but the {role} maneuver's "
                        f"{', '.join(worse)} worse ({detail}): the equation-error sizes are kept"), figures
+    raised = _raised_elsewhere(fits_ee, fits_cal, role, outputs)
+    figures["unjudged_raised"] = raised
+    if raised:
+        detail = ", ".join(f"{o} {v['equation_error']:.4g} → {v['calibrated']:.4g}" for o, v in raised.items())
+        return False, (f"the calibrated sizes fit the terms' own outputs no worse, but raise the {role} maneuver's "
+                       f"{', '.join(raised)} by more than {100 * UNJUDGED_TOLERANCE:.0f} % ({detail}): the "
+                       "equation-error sizes are kept"), figures
     detail = ", ".join(f"{o} {v['equation_error']:.4g} → {v['calibrated']:.4g}" for o, v in rms.items())
     return True, (f"the calibrated sizes fit the identification maneuver better (output-error cost {cost_ee:.4f} → "
                   f"{cost_cal:.4f}) and the {role} maneuver's {', '.join(outputs)} no worse ({detail})"), figures

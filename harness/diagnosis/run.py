@@ -258,6 +258,10 @@ def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, n
 # The |t| the same sensor parameter must reach, with the same sign, on the validation
 # maneuver for a sensor finding to be kept (the same instrument flew both maneuvers).
 SENSOR_CONFIRM_T = 3.0
+# For a sensor finding named on two tests (kinematics below their entry t, and the coefficient
+# mismatch; :mod:`harness.diagnosis.corroborate`), the validation maneuver's kinematic estimate
+# need reach only this |t| when it agrees with the identification's within two standard errors.
+CORROBORATED_CONFIRM_T = 2.0
 
 
 def _sensor_check(av: Analysis, f: Candidate) -> dict:
@@ -272,8 +276,18 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
     same = np.sign(twin.estimate) == np.sign(f.estimate)
     status = ("confirmed" if same and abs(twin.t) >= SENSOR_CONFIRM_T else
               "contradicted" if not same and abs(twin.t) >= SENSOR_CONFIRM_T else "neutral")
-    return {"status": status, "axes": [], "estimate": float(twin.estimate), "std_error": float(twin.std_error),
-            "t": float(twin.t)}
+    out = {"status": status, "axes": [], "estimate": float(twin.estimate), "std_error": float(twin.std_error),
+           "t": float(twin.t)}
+    kin = f.details.get("corroboration") or {}
+    if status == "neutral" and kin.get("named") and same and abs(twin.t) >= CORROBORATED_CONFIRM_T:
+        # named on two tests, each below the kinematic entry alone: the validation maneuver's
+        # kinematic estimate must agree with the identification's, at a lower |t|
+        apart = abs(twin.estimate - kin["kinematic"])
+        if apart <= 2.0 * np.hypot(twin.std_error, kin["kinematic_std"]):
+            out |= {"status": "confirmed", "rule": f"corroborated finding: same sign, |t| >= "
+                    f"{CORROBORATED_CONFIRM_T:g} and within two standard errors of the identification's kinematic "
+                    f"estimate ({kin['kinematic']:.4g} ± {kin['kinematic_std']:.2g})"}
+    return out
 
 
 def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
