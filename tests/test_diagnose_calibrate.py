@@ -122,10 +122,15 @@ def test_the_calibration_matches_the_outputs_the_decision_judges():
     assert matched_outputs(terms[1:2], has) is None
 
 
-def test_decide_keeps_the_equation_error_sizes_when_an_unjudged_output_gets_worse():
+def test_decide_weighs_an_unjudged_output_that_gets_worse_against_the_whole_maneuver():
     def fits(q, r):
         return {"validation": {"outputs": {"q": {"rms": q}, "r": {"rms": r}}}}
     ok, _, figures = decide(_cal(1.0, 0.9), fits(1.0, 1.0), fits(0.9, 1.019), ["q"])
     assert ok and figures["unjudged_raised"] == {}
-    ok, reason, figures = decide(_cal(1.0, 0.9), fits(1.0, 1.0), fits(0.9, 1.03), ["q"])
-    assert not ok and "raise the validation maneuver's r" in reason and set(figures["unjudged_raised"]) == {"r"}
+    # r up 3 % but q down 10 %: the maneuver's cost over every output falls, so it is used
+    ok, _, figures = decide(_cal(1.0, 0.9), fits(1.0, 1.0), fits(0.9, 1.03), ["q"])
+    assert ok and set(figures["unjudged_raised"]) == {"r"}
+    # r up 20 %, q down 10 %: the cost rises
+    ok, reason, figures = decide(_cal(1.0, 0.9), fits(1.0, 1.0), fits(0.9, 1.2), ["q"])
+    assert not ok and "raise the validation maneuver's r" in reason
+    assert figures["validation_cost"]["calibrated"] > figures["validation_cost"]["equation_error"]

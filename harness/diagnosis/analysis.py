@@ -85,7 +85,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     kin = plausible_kinematic_check(p)
     V0 = float(np.mean(p.smooth["V"]))
     plausible = _kinematics_plausible(kin, V0)
-    sensor_values = _sensor_values(kin, turbulent, plausible)
+    contested = _contested(kin)
+    sensor_values = {n: v for n, v in _sensor_values(kin, turbulent, plausible).items() if n not in contested}
     cands = _kinematic_candidates(kin, p, turbulent, plausible)
     recorded, p = p, _corrected(p, kin, sensor_values)
     # 2. the model along the measured states
@@ -110,6 +111,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         _withhold_in_turbulence(cands)
     else:
         signature = _signature_ratios(cands, kin, p, aircraft, ic, mismatch, step)
+        if plausible:
+            _kinematic_rivals(cands, kin, p, signature, contested)
         _withhold_vane_scale(cands, kin, step, signature)
         if plausible:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
@@ -653,6 +656,110 @@ def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared
         for c in cands:
             if c.details.get("sensor_rival") == name:
                 c.reason += f"; explained by the {name} named"
+
+
+def _kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float] | None:
+    """The unselected kinematic candidate most collinear with selected ``name`` (partial |r|,
+    the forced biases and the other selected terms taken out, at least
+    :data:`rivals.RIVAL_CORRELATION`), with the correlation and ``name``'s |t| beside it (those
+    terms in the fit); None when there is none."""
+    cols = kin.columns or {}
+    if name not in cols:
+        return None
+    fixed = [n for n in kin.forced + kin.selection.names if n != name and n in cols]
+    F = np.column_stack([cols[n] for n in fixed]) if fixed else np.zeros((kin.start.size, 0))
+
+    def partial(x: np.ndarray) -> np.ndarray:  # x with the fixed columns' part removed
+        return x - F @ np.linalg.lstsq(F, x, rcond=None)[0] if fixed else x
+    a = partial(cols[name])
+    best = None
+    for other, col in cols.items():
+        if other in fixed or other == name or np.ptp(col) <= 0:
+            continue
+        b = partial(col)
+        r = float(np.dot(a, b) / np.sqrt(np.dot(a, a) * np.dot(b, b))) if np.dot(b, b) > 0 else 0.0
+        if abs(r) >= rivals.RIVAL_CORRELATION and (best is None or abs(r) > abs(best[1])):
+            best = (other, r)
+    if best is None:
+        return None
+    try:
+        theta, se, _ = colored_fit(kin.start, [cols[n] for n in fixed] + [cols[name], cols[best[0]]],
+                                   fixed + [name, best[0]], constant=False)
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return best[0], best[1], 0.0
+    j = len(fixed)
+    return best[0], best[1], float(abs(theta[j] / se[j])) if se[j] > 0 else 0.0
+
+
+def _contested(kin: KinematicResult) -> dict[str, tuple[str, float, float]]:
+    """The selected kinematic terms the kinematics cannot tell from a rival
+    (:func:`_kinematic_rival`, |t| beside it below their entry t): not applied to the channels,
+    so that the coefficient mismatch can judge between the two (:func:`_kinematic_rivals`)."""
+    from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+    out = {}
+    for n in kin.selection.names:
+        found = _kinematic_rival(kin, n)
+        if found is not None and found[2] < KIN_T_IN:
+            out[n] = found
+    return out
+
+
+def _kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature,
+                      contested: dict[str, tuple[str, float, float]]) -> None:
+    """A sensor error the kinematics name is kept only when they tell it from its most
+    collinear rival (|t| >= their entry t beside it): on a pitch maneuver an α scale factor
+    and an a_z skew both follow α̇ in the ẇ equation. When they cannot, the coefficient
+    mismatch decides (:mod:`corroborate`: each rival's computed signature, at its own
+    kinematic size, against every axis): the one it corroborates and the other not is named;
+    otherwise neither is."""
+    by_name = {c.parameter: c for c in cands}
+    for c in [c for c in cands if c.selected and c.parameter in contested]:
+        rival, r, t_beside = contested[c.parameter]
+        other = by_name.get(rival)
+        solo = _kin_estimate(kin, rival)
+        verdicts = {}
+        for name, (v, t) in ((c.parameter, (c.estimate, abs(c.t))), (rival, solo or (0.0, 0.0))):
+            if v == 0.0 or t <= 0:
+                verdicts[name] = None
+                continue
+            verdicts[name] = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
+        own, theirs = verdicts[c.parameter], verdicts[rival]
+        c.details["kinematic_rival"] = {"parameter": rival, "correlation": r, "t_beside": t_beside,
+                                        "own": own.as_dict() if own else None,
+                                        "rival": theirs.as_dict() if theirs else None}
+        if own is not None and own.named and not (theirs is not None and theirs.named):
+            c.reason += (f"; the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = {t_beside:.1f}), "
+                         "but the coefficient mismatch shows this one, not that")
+            continue
+        c.selected = False
+        if theirs is not None and theirs.named and not (own is not None and own.named) and other is not None:
+            c.reason = (f"not named: the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = "
+                        f"{t_beside:.1f}), and the coefficient mismatch shows {rival}, not this")
+            _name_if_corroborated(other, kin, p, theirs, solo[1])
+            other.reason = theirs.reason + (f" (kinematic t = {solo[1]:.1f}; the kinematics alone cannot tell it "
+                                            f"from {c.parameter})")
+        else:
+            c.reason = (f"not named: the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = "
+                        f"{t_beside:.1f}), nor can the coefficient mismatch")
+        _withhold_absorbed_biases(cands, kin, c.parameter, rival)
+
+
+def _withhold_absorbed_biases(cands: list[Candidate], kin: KinematicResult, dropped: str, rival: str) -> None:
+    """With the kinematic fit redone on ``rival`` in place of ``dropped`` (the two it cannot tell
+    apart), a named bias whose |t| falls below the entry t is part of the rival's error (an α
+    scale factor shifts α's mean by k·ᾱ, which a bias otherwise takes) and is not named."""
+    cols = kin.columns or {}
+    names = [n for n in kin.forced + kin.selection.names if n != dropped and n in cols] + [rival]
+    try:
+        theta, se, _ = colored_fit(kin.start, [cols[n] for n in names], names, constant=False)
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return
+    t_alt = {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
+    for c in cands:
+        if c.selected and c.parameter in kin.forced and t_alt.get(c.parameter, np.inf) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"not named: with {rival} in place of {dropped} (the kinematics cannot tell them apart) it "
+                        f"falls to t = {t_alt[c.parameter]:.1f}: it may be part of {rival}")
 
 
 def _name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepared, p: Prepared,

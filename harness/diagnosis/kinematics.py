@@ -181,6 +181,7 @@ class KinematicResult:
     weights: dict[str, float]
     residual_rms: dict[str, float]   # per equation, before (weighted units removed)
     start: np.ndarray                # stacked weighted residual before corrections
+    columns: dict = None             # every offered parameter's stacked weighted column (forced too)
 
 
 T_IN = 6.0
@@ -234,12 +235,14 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
     for name in exclude:  # parameters an earlier pass found implausible (see analysis)
         if columns.pop(name, None) is not None:
             dropped[name] = "implausible size in an earlier fit: refitted without it"
+    offered = dict(columns)
     forced = {f"bias_{c}": columns.pop(f"bias_{c}") for c in NUISANCE_BIASES if f"bias_{c}" in columns}
     sel = colored_forward_selection(stack, columns, forced=forced, t_in=t_in, min_gain=min_gain, max_terms=max_terms,
                                     constant=False)
     return KinematicResult(selection=sel, parameters=params, forced=tuple(forced), dropped=dropped,
                            equations=eqs, weights=weights,
-                           residual_rms={e: float(np.sqrt(np.mean(e0[e][inner] ** 2))) for e in eqs}, start=stack)
+                           residual_rms={e: float(np.sqrt(np.mean(e0[e][inner] ** 2))) for e in eqs}, start=stack,
+                           columns=offered)
 
 
 # The largest error an instrument of each kind plausibly has (a vane 5 deg off, a gyro 5 deg/s,

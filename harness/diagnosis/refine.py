@@ -117,7 +117,8 @@ def _rms(fits: dict, role: str, channel: str) -> float | None:
 
 
 # An output the terms do not drive may move a little when their sizes change (the replay's
-# trim moves with them); more than this fraction of its RMS error is a worse fit.
+# trim moves with them); more than this fraction of its RMS error is a worse fit, accepted
+# only when the maneuver's cost over every output still falls.
 UNJUDGED_TOLERANCE = 0.02
 
 
@@ -131,6 +132,18 @@ def _raised_elsewhere(fits_ee: dict, fits_cal: dict, role: str, judged: list[str
         if e is not None and c is not None and np.isfinite(e) and np.isfinite(c) and c > e * (1 + UNJUDGED_TOLERANCE):
             out[o] = {"equation_error": e, "calibrated": c}
     return out
+
+
+def _total_cost(fits_ee: dict, fits_cal: dict, role: str) -> dict:
+    """Σ ln RMS over every output both replays of ``role`` give (the output-error likelihood
+    with the noise estimated, per sample): {"equation_error", "calibrated", "outputs"}."""
+    e_out = (fits_ee.get(role) or {}).get("outputs") or {}
+    c_out = (fits_cal.get(role) or {}).get("outputs") or {}
+    names = [o for o in sorted(set(e_out) & set(c_out))
+             if all(isinstance(v, (int, float)) and np.isfinite(v) and v > 0
+                    for v in (_rms(fits_ee, role, o), _rms(fits_cal, role, o)))]
+    return {"equation_error": float(sum(math.log(_rms(fits_ee, role, o)) for o in names)),
+            "calibrated": float(sum(math.log(_rms(fits_cal, role, o)) for o in names)), "outputs": names}
 
 
 def decide(cal, fits_ee: dict, fits_cal: dict, outputs: list[str]) -> tuple[bool, str, dict]:
@@ -175,12 +188,15 @@ def decide(cal, fits_ee: dict, fits_cal: dict, outputs: list[str]) -> tuple[bool
         return False, (f"the calibrated sizes fit the identification maneuver better but the {role} maneuver's "
                        f"{', '.join(worse)} worse ({detail}): the equation-error sizes are kept"), figures
     raised = _raised_elsewhere(fits_ee, fits_cal, role, outputs)
+    total = _total_cost(fits_ee, fits_cal, role)
     figures["unjudged_raised"] = raised
-    if raised:
+    figures[f"{role}_cost"] = total
+    if raised and total["calibrated"] > total["equation_error"]:
         detail = ", ".join(f"{o} {v['equation_error']:.4g} → {v['calibrated']:.4g}" for o, v in raised.items())
         return False, (f"the calibrated sizes fit the terms' own outputs no worse, but raise the {role} maneuver's "
-                       f"{', '.join(raised)} by more than {100 * UNJUDGED_TOLERANCE:.0f} % ({detail}): the "
-                       "equation-error sizes are kept"), figures
+                       f"{', '.join(raised)} by more than {100 * UNJUDGED_TOLERANCE:.0f} % ({detail}) and its "
+                       f"output-error cost over every output ({total['equation_error']:.4f} → "
+                       f"{total['calibrated']:.4f}): the equation-error sizes are kept"), figures
     detail = ", ".join(f"{o} {v['equation_error']:.4g} → {v['calibrated']:.4g}" for o, v in rms.items())
     return True, (f"the calibrated sizes fit the identification maneuver better (output-error cost {cost_ee:.4f} → "
                   f"{cost_cal:.4f}) and the {role} maneuver's {', '.join(outputs)} no worse ({detail})"), figures
