@@ -13,7 +13,8 @@ from harness.diagnosis.gusts import process_noise_model
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
-                                          is_plausible, is_practical, kinematic_check, kinematic_residuals)
+                                          inertial_angles, is_plausible, is_practical, kinematic_check,
+                                          kinematic_residuals)
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
 from models.aircraft import Aircraft, has_propeller
@@ -113,7 +114,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         signature = _signature_ratios(cands, kin, p, aircraft, ic, mismatch, step)
         if plausible:
             _kinematic_rivals(cands, kin, p, signature, contested)
-        _withhold_vane_scale(cands, kin, step, signature)
+        _withhold_vane_scale(cands, kin, step, signature, inertial_beta(p))
         if plausible:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
@@ -213,11 +214,21 @@ def model_states(p: Prepared) -> tuple[dict[str, np.ndarray], dict[str, np.ndarr
     little noise: always as recorded (holding one that moves, say by a feedback loop, would
     be far worse than its noise). Airspeed and altitude are slow: their own optimal
     smoothing (a far lower cut-off than the common filter's) keeps their noise out of the
-    model's coefficients (through q̂ = qc̄/2V, dynamic pressure and Mach-scheduled terms)."""
+    model's coefficients (through q̂ = qc̄/2V, dynamic pressure and Mach-scheduled terms).
+
+    A driven sideslip is the inertial one (:func:`kinematics.inertial_angles`: the v̇ equation
+    integrated from a_y, the rates and attitude, placed on the vane by a constant and trend):
+    a vane's slow wander survives any smoother and reaches the mismatch through C_n,β, C_l,β
+    and C_Y,β, where it buried the outside sweep's lateral coefficient errors (C_l,β −0.02,
+    C_n,β +0.03, C_n,r̂ −0.3, C_l,p̂ −0.1 at |t| 1.6–4.7; 5.9–22 along the inertial β). A β-vane
+    scale then leaves the mismatch alone; the kinematic check names it."""
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven:
             states[k] = np.full(p.n, p.start[k])
+    if inertial_beta(p):
+        clean = {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in INERTIAL_CHANNELS}
+        states["beta"] = inertial_angles(clean, p)["beta"]
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
@@ -246,6 +257,15 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> ModelA
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
     return ModelAlong(states, surfaces, alphadot, aero, measured)
+
+
+# What the inertial sideslip is integrated from (kinematics.inertial_angles).
+INERTIAL_CHANNELS = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ay", "az")
+
+
+def inertial_beta(p: Prepared) -> bool:
+    """Whether the model is evaluated along the inertial sideslip (:func:`model_states`)."""
+    return "beta" in p.driven and all(c in p.raw for c in INERTIAL_CHANNELS)
 
 
 def _inner(p: Prepared) -> slice:
@@ -608,14 +628,17 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
 PROBE_SCALE = 0.05
 
 
-def _withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: _Stepwise, signature) -> None:
+def _withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: _Stepwise, signature,
+                         inertial: bool = False) -> None:
     """Deselect coefficient errors on α or β that a scale error of that vane would imitate on
     every axis that can tell (:func:`corroborate.imitates`): the model evaluated along a
     scaled angle is off by each coefficient's own slope times the scaled excursion, so a
     vane scale looks like C_Z,α, C_m,α and C_X,α wrong in the model's own proportions, which
     no single coefficient error does. The kinematics cannot always see the scale (its
-    column is nearly a bias's when the angle hardly moves about its mean)."""
-    for x in ("alpha", "beta"):
+    column is nearly a bias's when the angle hardly moves about its mean). Not for β when the
+    model follows the inertial sideslip (``inertial``): a vane scale cannot reach the mismatch
+    then. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing."""
+    for x in ("alpha",) + (() if inertial else ("beta",)):
         name = f"scale_{x}"
         chosen = [c for c in cands if c.selected and c.effect == "coefficient_error"
                   and cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1]) == x]
@@ -623,7 +646,7 @@ def _withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: _St
             continue
         same = frozenset(c.parameter for c in cands if c.parameter.endswith(f"_{x}") and c.test.startswith("stepwise"))
         ag = corroborate.imitates(signature(name, PROBE_SCALE, same), t_aero=cand.T_IN)
-        if ag is None:
+        if ag is None or not is_plausible(name, ag.ratio * PROBE_SCALE, 1.0):
             continue
         for c in chosen:
             c.selected = False
@@ -658,11 +681,11 @@ def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared
                 c.reason += f"; explained by the {name} named"
 
 
-def _kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float] | None:
+def _kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float, float] | None:
     """The unselected kinematic candidate most collinear with selected ``name`` (partial |r|,
     the forced biases and the other selected terms taken out, at least
-    :data:`rivals.RIVAL_CORRELATION`), with the correlation and ``name``'s |t| beside it (those
-    terms in the fit); None when there is none."""
+    :data:`rivals.RIVAL_CORRELATION`), with the correlation, ``name``'s |t| beside it and the
+    rival's |t| beside ``name`` (those terms in the fit); None when there is none."""
     cols = kin.columns or {}
     if name not in cols:
         return None
@@ -686,21 +709,27 @@ def _kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float
         theta, se, _ = colored_fit(kin.start, [cols[n] for n in fixed] + [cols[name], cols[best[0]]],
                                    fixed + [name, best[0]], constant=False)
     except (SingularRegressorsError, np.linalg.LinAlgError):
-        return best[0], best[1], 0.0
+        return best[0], best[1], 0.0, 0.0
     j = len(fixed)
-    return best[0], best[1], float(abs(theta[j] / se[j])) if se[j] > 0 else 0.0
+    t_own = float(abs(theta[j] / se[j])) if se[j] > 0 else 0.0
+    t_rival = float(abs(theta[j + 1] / se[j + 1])) if se[j + 1] > 0 else 0.0
+    return best[0], best[1], t_own, t_rival
 
 
 def _contested(kin: KinematicResult) -> dict[str, tuple[str, float, float]]:
     """The selected kinematic terms the kinematics cannot tell from a rival
-    (:func:`_kinematic_rival`, |t| beside it below their entry t): not applied to the channels,
-    so that the coefficient mismatch can judge between the two (:func:`_kinematic_rivals`)."""
+    (:func:`_kinematic_rival`: |t| beside it below their entry t, unless it stays at least
+    :data:`AMBIGUOUS_T` there while the rival falls below it): not applied to the channels, so
+    that the coefficient mismatch can judge between the two (:func:`_kinematic_rivals`)."""
     from harness.diagnosis.kinematics import T_IN as KIN_T_IN
     out = {}
     for n in kin.selection.names:
         found = _kinematic_rival(kin, n)
-        if found is not None and found[2] < KIN_T_IN:
-            out[n] = found
+        if found is None or found[2] >= KIN_T_IN:
+            continue
+        if found[2] >= AMBIGUOUS_T and found[3] < AMBIGUOUS_T:
+            continue  # beside each other, the data still prefer this one
+        out[n] = found[:3]
     return out
 
 

@@ -118,13 +118,18 @@ def sensor_parameters(p: Prepared) -> tuple[SensorParameter, ...]:
     return tuple(out)
 
 
-def _integrated(rate: np.ndarray, measured: np.ndarray, dt: float) -> np.ndarray:
-    """``rate`` integrated (trapezoid) and placed on ``measured`` by a least-squares constant
-    and linear trend (an accelerometer bias integrates to a ramp); what is left of
-    ``measured`` is its slow noise, which the integral does not have."""
-    x = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * dt)])
+def _integral(x: np.ndarray, dt: float) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(0.5 * (x[1:] + x[:-1]) * dt)])
+
+
+def _integrated(rate: np.ndarray, measured: np.ndarray, dt: float, drifts: tuple[np.ndarray, ...] = ()) -> np.ndarray:
+    """``rate`` integrated (trapezoid) and placed on ``measured`` by least squares on a
+    constant, a linear trend (an accelerometer bias integrates to a ramp) and ``drifts``
+    (what a gyro bias integrates to: a q bias in ẇ = qu − pv + ... gives −b ∫u dt); what is
+    left of ``measured`` is its slow noise, which the integral does not have."""
+    x = _integral(rate, dt)
     t = np.arange(x.size) * dt
-    A = np.column_stack([np.ones_like(t), t])
+    A = np.column_stack([np.ones_like(t), t, *drifts])
     c, *_ = np.linalg.lstsq(A, measured - x, rcond=None)
     return x + A @ c
 
@@ -132,7 +137,9 @@ def _integrated(rate: np.ndarray, measured: np.ndarray, dt: float) -> np.ndarray
 def inertial_angles(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndarray]:
     """α and β reconstructed from the inertial instruments: the body w and v equations of the
     module docstring integrated from the accelerometers, gyros and attitude, and placed on
-    the vanes' own w and v by a constant and trend (:func:`_integrated`).
+    the vanes' own w and v by a constant, a trend and what the gyro biases integrate to
+    (:func:`_integrated`; without the gyro terms a p bias times w, which changes with airspeed
+    and α, left a drift that read as C_l and C_n ΔV/V terms at 330 ft/s).
 
     The vanes' slow noise (a Gauss-Markov wander survives any smoother: it is in the
     maneuver's band) is in the kinematic residual through d(V sin α)/dt; sensitivity columns
@@ -146,7 +153,9 @@ def inertial_angles(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndar
     g = G0 * np.cos(th)
     w_dot = Q * u - P * v + g * np.cos(phi) + G0 * ch["az"]
     v_dot = P * w - R * u + g * np.sin(phi) + G0 * ch["ay"]
-    w_i, v_i = _integrated(w_dot, w, p.dt), _integrated(v_dot, v, p.dt)
+    iu, iv, iw = (_integral(x, p.dt) for x in (u, v, w))
+    w_i = _integrated(w_dot, w, p.dt, (iu, iv))   # q and p biases
+    v_i = _integrated(v_dot, v, p.dt, (iw, iu))   # p and r biases
     beta = np.arcsin(np.clip(v_i / V, -1.0, 1.0))
     return {"alpha": np.arctan2(w_i, u), "beta": beta}
 
