@@ -205,7 +205,8 @@ def _corrected(p: Prepared, kin: KinematicResult, values: dict[str, float]) -> P
     return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
 
 
-def model_states(p: Prepared) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+def model_states(p: Prepared, inertial_from: Prepared | None = None) -> tuple[dict[str, np.ndarray],
+                                                                              dict[str, np.ndarray]]:
     """The states and surfaces the model is evaluated along.
 
     A state the maneuver did not drive is held at its start: evaluated along its noise, the
@@ -227,8 +228,9 @@ def model_states(p: Prepared) -> tuple[dict[str, np.ndarray], dict[str, np.ndarr
         if k in states and k not in p.driven:
             states[k] = np.full(p.n, p.start[k])
     if inertial_beta(p):
-        clean = {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in INERTIAL_CHANNELS}
-        states["beta"] = inertial_angles(clean, p)["beta"]
+        src = inertial_from or p
+        clean = {c: src.raw[c] - src.own_noise[c] if c in src.own_noise else src.raw[c] for c in INERTIAL_CHANNELS}
+        states["beta"] = inertial_angles(clean, src)["beta"]
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
@@ -250,9 +252,11 @@ class ModelAlong(NamedTuple):
         return {c: self.measured[c] - self.aero.coefficients[c] for c in COEFFICIENTS}
 
 
-def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> ModelAlong:
-    """The measured coefficients and the model's along the states of :func:`model_states`."""
-    states, surfaces = model_states(p)
+def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
+                inertial_from: Prepared | None = None) -> ModelAlong:
+    """The measured coefficients and the model's along the states of :func:`model_states`
+    (its inertial sideslip integrated from ``inertial_from``, default ``p``)."""
+    states, surfaces = model_states(p, inertial_from)
     alphadot = p.deriv["alpha"] if "alpha" in p.driven else None
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
@@ -611,7 +615,10 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
     inner = _inner(p)
 
     def ratios(name: str, value: float, skip: frozenset[str] = frozenset()) -> dict:
-        changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic).mismatch()
+        # the inertial sideslip stays the one integrated from p: it is built from the same
+        # instruments as the kinematic check, so letting it follow the correction would make
+        # the two tests one
+        changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
         out = {}
         for axis, (sel, by_key) in step.selections.items():
             kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
@@ -804,7 +811,7 @@ def _name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepar
         if sensor is None or sensor.selected or sensor.reason != "below the entry t":
             continue
         without = _corrected(recorded, kin, {k: x for k, x in applied.items() if k != name})
-        base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic).mismatch().items()}
+        base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic, inertial_from=p).mismatch().items()}
         ratios = {}
         for axis, (sel, by_key) in step.selections.items():
             kept = {c.parameter for c in cands if c.selected and c.channel == axis}
