@@ -186,8 +186,8 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     """What one identification finding, with its size as estimated, does to the validation
     maneuver's coefficient mismatch on its axes (a prediction: nothing is refitted).
 
-    ``status`` is 'confirmed' (the mismatch RMS drops by 1 % or more), 'contradicted' (it
-    rises by 1 % or more) or 'neutral'; None for a finding with no coefficient term (a
+    ``status`` is 'confirmed' (the mismatch RMS, summed over its axes in units of each axis's
+    noise level, drops by 1 % or more), 'contradicted' (it rises by 1 % or more) or 'neutral'; None for a finding with no coefficient term (a
     sensor effect, a gust level, a spectral peak)."""
     if f.test.startswith("kinematic consistency") or f.parameter == "x_accelerometer":
         return _sensor_check(av, f)
@@ -198,7 +198,10 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     inner = _inner(av.prepared)
     before_rms = {c: _rms(av.mismatch[c][inner]) for c in axes}
     after_rms = {c: _rms(after[c][inner]) for c in axes}
-    ratio = sum(after_rms.values()) / max(sum(before_rms.values()), 1e-300)
+    # each axis in units of its own noise level: summed raw, C_Y's mismatch (a_y noise) would
+    # outweigh a C_l or C_n change ten times smaller in coefficient units but larger in noise
+    w = {c: 1.0 / max(av.noise.get(c, 1.0), 1e-300) for c in axes}
+    ratio = sum(w[c] * after_rms[c] for c in axes) / max(sum(w[c] * before_rms[c] for c in axes), 1e-300)
     status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
     out = {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms, "change": ratio - 1.0}
     rival = _rival_check(av, f, axes, {c: after[c][inner] for c in axes})
