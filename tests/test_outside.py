@@ -196,3 +196,12 @@ def test_an_alpha_scale_the_kinematics_cannot_tell_from_an_az_skew_is_not_misnam
     row = sweep(tmp_path, ["scale_alpha_0.08"], workers=1)[0]
     assert row["first"]["parameter"] in ("scale_alpha", ""), row["first"]
     assert not row.get("also"), row.get("also")
+
+
+def test_a_yaw_gyro_bias_is_seen_through_the_heading(tmp_path):
+    """Outside case F_lateral (0.5 deg/s r bias): in the v equation an r bias (−R·u) is one
+    column with an a_y bias; the heading equation (psi-dot) sees the yaw gyro directly."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "F_lateral_sensor_bias_bias_r_0.5deg")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]

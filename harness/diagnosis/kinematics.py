@@ -5,6 +5,7 @@ The rigid-body kinematics tie the recorded channels together whatever the aerody
     u̇ = rv − qw − g sinθ + g a_x            φ̇ = p + tanθ (q sinφ + r cosφ)
     v̇ = pw − ru + g cosθ sinφ + g a_y       θ̇ = q cosφ − r sinφ
     ẇ = qu − pv + g cosθ cosφ + g a_z       ḣ = u sinθ − v sinφ cosθ − w cosφ cosθ
+                                            ψ̇ = (q sinφ + r cosφ) / cosθ
 
 with u, v, w from V, α, β. Each equation's residual E (left minus right, both through the
 recording's common filter) is zero for perfect sensors. A sensor effect with parameter θ —
@@ -177,6 +178,10 @@ def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.
     }
     if h is not None:
         out["h"] = D(h) - F(u * np.sin(th) - v * np.sin(phi) * np.cos(th) - w * np.cos(phi) * np.cos(th))
+    if "psi" in ch:
+        # the heading sees the yaw gyro directly: without it an r bias (−R·u in the v
+        # equation) is one column with an a_y bias
+        out["psi"] = D(np.unwrap(ch["psi"])) - F((Q * np.sin(phi) + R * np.cos(phi)) / np.cos(th))
     return out
 
 
