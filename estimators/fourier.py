@@ -151,6 +151,17 @@ def _as_samples(x: npt.ArrayLike, min_len: int) -> np.ndarray:
     return a
 
 
+def _transform_inputs(x: npt.ArrayLike, dt: float, frequencies_hz: npt.ArrayLike,
+                      min_len: int) -> tuple[np.ndarray, bool, float, np.ndarray]:
+    """The checked inputs of a transform: samples as columns, whether ``x`` was 1-D, ``dt``
+    and the angular frequencies."""
+    a = _as_samples(x, min_len)
+    dt = _check_dt(dt)
+    omega = 2.0 * np.pi * _as_frequencies(frequencies_hz)
+    one_d = a.ndim == 1
+    return (a[:, None] if one_d else a), one_d, dt, omega
+
+
 def _check_dt(dt: float) -> float:
     dt = float(dt)
     if not (np.isfinite(dt) and dt > 0.0):
@@ -359,13 +370,8 @@ def finite_fourier_transform(
     E. A. Morelli, "Practical Aspects of the Equation-Error Method for
     Aircraft Parameter Estimation" (seed paper), Eqs. 18-23.
     """
-    a = _as_samples(x, 4)
-    dt = _check_dt(dt)
-    f = _as_frequencies(frequencies_hz)
-    one_d = a.ndim == 1
-    a2 = a[:, None] if one_d else a
+    a2, one_d, dt, omega = _transform_inputs(x, dt, frequencies_hz, 4)
     n = a2.shape[0]
-    omega = 2.0 * np.pi * f
     theta = omega * dt
     w, alpha = interpolation_weights(theta)
     s = _riemann_sums(a2, theta)
@@ -409,12 +415,7 @@ def plain_dft(
     numpy.ndarray
         Complex, shape ``(m,)`` or ``(m, ncols)``.
     """
-    a = _as_samples(x, 1)
-    dt = _check_dt(dt)
-    f = _as_frequencies(frequencies_hz)
-    one_d = a.ndim == 1
-    a2 = a[:, None] if one_d else a
-    omega = 2.0 * np.pi * f
+    a2, one_d, dt, omega = _transform_inputs(x, dt, frequencies_hz, 1)
     s = _riemann_sums(a2, omega * dt)
     out = dt * np.exp(-1j * omega * float(t0))[:, None] * s
     return out[:, 0] if one_d else out
@@ -459,12 +460,7 @@ def held_fourier_transform(
     numpy.ndarray
         Complex, shape ``(m,)`` or ``(m, ncols)``.
     """
-    a = _as_samples(x, 2)
-    dt = _check_dt(dt)
-    f = _as_frequencies(frequencies_hz)
-    one_d = a.ndim == 1
-    a2 = a[:, None] if one_d else a
-    omega = 2.0 * np.pi * f
+    a2, one_d, dt, omega = _transform_inputs(x, dt, frequencies_hz, 2)
     theta = omega * dt
     s = _riemann_sums(a2[:-1], theta)
     # (1 - exp(-j theta)) / (j omega) = dt * exp(-j theta/2) * sinc(theta/2), finite at 0

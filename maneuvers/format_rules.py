@@ -235,6 +235,13 @@ def _check_format(rec: Recording, src: str) -> None:
         )
 
 
+def _require_object(value, name: str, src: str, rule: str) -> None:
+    """A metadata block that must be a JSON object: refused (``rule``) when it is not."""
+    if not isinstance(value, dict):
+        raise RecordingError(f"{name} must be an object, got {type(value).__name__}",
+                             source=src, key=_metakey(name), rule=rule)
+
+
 def _check_geometry(rec: Recording, src: str) -> None:
     geometry = rec.meta.get("geometry")
     if geometry is None:
@@ -242,11 +249,7 @@ def _check_geometry(rec: Recording, src: str) -> None:
             f"geometry is missing; needs {', '.join(GEOMETRY_KEYS)}",
             source=src, key=_metakey("geometry"), rule="missing-geometry",
         )
-    if not isinstance(geometry, dict):
-        raise RecordingError(
-            f"geometry must be an object, got {type(geometry).__name__}",
-            source=src, key=_metakey("geometry"), rule="bad-geometry",
-        )
+    _require_object(geometry, "geometry", src, "bad-geometry")
     _refuse_unknown_keys(geometry, GEOMETRY_KEYS, src, "geometry")
     for key in GEOMETRY_KEYS:
         if key not in geometry:
@@ -264,11 +267,7 @@ def _check_geometry(rec: Recording, src: str) -> None:
 
 def _check_mass(rec: Recording, src: str) -> None:
     mass = rec.meta.get("mass", {})
-    if not isinstance(mass, dict):
-        raise RecordingError(
-            f"mass must be an object, got {type(mass).__name__}",
-            source=src, key=_metakey("mass"), rule="bad-mass",
-        )
+    _require_object(mass, "mass", src, "bad-mass")
     _refuse_unknown_keys(mass, MASS_KEYS, src, "mass")
     for key in MASS_KEYS:
         in_meta = key in mass
@@ -305,11 +304,7 @@ def _check_mass(rec: Recording, src: str) -> None:
 def _check_optional_meta(rec: Recording, src: str) -> None:
     sensors = rec.meta.get("sensors")
     if sensors is not None:
-        if not isinstance(sensors, dict):
-            raise RecordingError(
-                f"sensors must be an object, got {type(sensors).__name__}",
-                source=src, key=_metakey("sensors"), rule="bad-sensors",
-            )
+        _require_object(sensors, "sensors", src, "bad-sensors")
         for key, pos in sensors.items():
             if key.endswith("_ft") and not (
                 isinstance(pos, (list, tuple)) and len(pos) == 3 and all(_finite_real(x) for x in pos)
@@ -323,11 +318,8 @@ def _check_optional_meta(rec: Recording, src: str) -> None:
             f"must be a finite number, got {rec.meta['thrust_offset_ft']!r}",
             source=src, key=_metakey("thrust_offset_ft"), rule="bad-thrust-offset",
         )
-    if "trim" in rec.meta and not isinstance(rec.meta["trim"], dict):
-        raise RecordingError(
-            f"must be an object, got {type(rec.meta['trim']).__name__}",
-            source=src, key=_metakey("trim"), rule="bad-trim",
-        )
+    if "trim" in rec.meta:
+        _require_object(rec.meta["trim"], "trim", src, "bad-trim")
     for key, value in rec.meta.get("trim", {}).items():
         if not _finite_real(value):
             raise RecordingError(

@@ -12,10 +12,11 @@ from harness.diagnosis import corroborate, rivals
 from harness.diagnosis.gusts import process_noise_model
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
                                           inertial_angles, is_plausible, is_practical, kinematic_check,
                                           kinematic_residuals)
-from harness.diagnosis.prepare import COEFFICIENTS, Prepared, measured_coefficients
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, measured_coefficients
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
 from models.aircraft import Aircraft, has_propeller
 from models.replay import AeroAlong, InitialCondition, aero_along
@@ -229,8 +230,7 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None) -> tuple[di
             states[k] = np.full(p.n, p.start[k])
     if inertial_beta(p):
         src = inertial_from or p
-        clean = {c: src.raw[c] - src.own_noise[c] if c in src.own_noise else src.raw[c] for c in INERTIAL_CHANNELS}
-        states["beta"] = inertial_angles(clean, src)["beta"]
+        states["beta"] = inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)["beta"]
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
@@ -619,16 +619,23 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
         # instruments as the kinematic check, so letting it follow the correction would make
         # the two tests one
         changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
-        out = {}
-        for axis, (sel, by_key) in step.selections.items():
-            kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
-            others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
-            others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
-            r = corroborate.axis_ratio(mismatch[axis][inner], others, (changed[axis] - mismatch[axis])[inner])
-            if r is not None:
-                out[axis] = r
-        return out
+        return _axis_ratios(cands, step, inner, mismatch, changed, skip)
     return ratios
+
+
+def _axis_ratios(cands: list[Candidate], step: _Stepwise, inner: slice, base: dict[str, np.ndarray],
+                 changed: dict[str, np.ndarray], skip: frozenset[str] = frozenset()) -> dict:
+    """Per axis, :func:`corroborate.axis_ratio` of ``base`` on the change ``changed - base``,
+    beside the axis's named terms (those in ``skip`` left out) and its nuisance columns."""
+    out = {}
+    for axis, (sel, by_key) in step.selections.items():
+        kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
+        others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
+        r = corroborate.axis_ratio(base[axis][inner], others, (changed[axis] - base[axis])[inner])
+        if r is not None:
+            out[axis] = r
+    return out
 
 
 # The vane scale factor at which its signature is evaluated (the fit scales it).
@@ -728,7 +735,6 @@ def _contested(kin: KinematicResult) -> dict[str, tuple[str, float, float]]:
     (:func:`_kinematic_rival`: |t| beside it below their entry t, unless it stays at least
     :data:`AMBIGUOUS_T` there while the rival falls below it): not applied to the channels, so
     that the coefficient mismatch can judge between the two (:func:`_kinematic_rivals`)."""
-    from harness.diagnosis.kinematics import T_IN as KIN_T_IN
     out = {}
     for n in kin.selection.names:
         found = _kinematic_rival(kin, n)
@@ -812,14 +818,7 @@ def _name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepar
             continue
         without = _corrected(recorded, kin, {k: x for k, x in applied.items() if k != name})
         base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic, inertial_from=p).mismatch().items()}
-        ratios = {}
-        for axis, (sel, by_key) in step.selections.items():
-            kept = {c.parameter for c in cands if c.selected and c.channel == axis}
-            others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
-            others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
-            r = corroborate.axis_ratio(base[axis][inner], others, (mismatch[axis] - base[axis])[inner])
-            if r is not None:
-                ratios[axis] = r
+        ratios = _axis_ratios(cands, step, inner, base, mismatch)
         _name_if_corroborated(sensor, kin, p, corroborate.corroborate(name, v, abs(v) / _t_of(kin, name), ratios,
                                                                       t_aero=cand.T_IN), _t_of(kin, name))
 
@@ -865,7 +864,7 @@ def _kin_share(kin: KinematicResult, name: str, value: float, p: Prepared) -> fl
     excursion (:func:`kinematics.channel_share`): practical significance, as for the
     aerodynamic terms (a noise-free flight asks for a 2 ft β-vane offset at t = 69, a
     0.01 deg change in β)."""
-    clean = {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in p.raw}
+    clean = clean_channels(p)
     k = max(1, int(round(1.0 / p.dt)))
     return channel_share(kin.parameters[name], value, clean, p, slice(k, p.n - k))
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_forward_selection
-from harness.diagnosis.prepare import Prepared
+from harness.diagnosis.prepare import Prepared, clean_channels
 from models.constants import G0_FPS2 as G0
 
 EARTH_RADIUS_FT = 20_925_646.3
@@ -195,7 +195,7 @@ class KinematicResult:
     weights: dict[str, float]
     residual_rms: dict[str, float]   # per equation, before (weighted units removed)
     start: np.ndarray                # stacked weighted residual before corrections
-    columns: dict = None             # every offered parameter's stacked weighted column (forced too)
+    columns: dict | None = None      # every offered parameter's stacked weighted column (forced too)
 
 
 T_IN = 6.0
@@ -215,7 +215,7 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
     scale factor of +0.23 ± 0.07 on a flight that has none). The biases of
     ``NUISANCE_BIASES`` are always in the fit."""
     ch = dict(p.raw)
-    clean = {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in p.raw}
+    clean = clean_channels(p)
     # The first and last second are where the sine-series filter is least accurate.
     k = max(1, int(round(1.0 / p.dt)))
     inner = slice(k, p.n - k)

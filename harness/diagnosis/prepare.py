@@ -95,6 +95,12 @@ class Prepared:
         return sine_series_derivative(x, self.weights, self.dt)
 
 
+def clean_channels(p: Prepared, names=None) -> dict[str, np.ndarray]:
+    """Each raw channel (of ``names``, default all) less its own noise: its own optimal
+    smoothing, not the common filter's."""
+    return {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in (names or p.raw)}
+
+
 def _channels(rec: Recording) -> dict[str, np.ndarray]:
     out = {}
     for q, unit in UNITS.items():
