@@ -19,10 +19,9 @@ from models.constants import SURFACES
 from models.flight import FlightError
 from models.jsbsim_root import write_root
 from models.mass import MassProperties, set_mass_properties
-from models.replay import InitialCondition, initial_condition, replay
+from models.replay import InitialCondition, initial_condition, replay, steady_start
 from models.trim import TrimError
 
-START_WINDOW_S = 0.5
 HOLDS = ("linear", "sample")
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
 UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi": "rad", "theta": "rad",
@@ -100,19 +99,6 @@ def _altitude(rec) -> np.ndarray:
         rho = 2.0 * rec.channel("qbar") / np.maximum(rec.channel("V"), 1.0) ** 2
         return density_altitude_ft(np.clip(rho, 1e-6, None))
     raise CalibrationError(f"recording {rec.name!r} has neither an altitude (h) nor qbar and V to start the model at")
-
-
-def steady_start(x: np.ndarray, t: np.ndarray, window_s: float = START_WINDOW_S) -> np.ndarray:
-    """``x`` with its first sample replaced by the median of its first ``window_s`` seconds.
-
-    The replay moves each surface by its recorded change from the first sample
-    (:func:`models.replay.replay`): with a noisy potentiometer, that sample's noise would
-    become a constant deflection for the whole flight (0.05° of rudder is a steady sideslip).
-    """
-    k = max(1, int(np.ceil(window_s / float(np.median(np.diff(t))))))
-    out = np.array(x, dtype=float)
-    out[0] = float(np.median(out[:k]))
-    return out
 
 
 def maneuver(rec, outputs: tuple[str, ...] | None = None, hold: str = "linear") -> Maneuver:

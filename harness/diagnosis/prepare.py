@@ -11,6 +11,7 @@ from estimators.smoothing import optimal_fourier_smoother, sine_series_derivativ
 from harness.isa import density_altitude_ft
 from maneuvers.recording import Recording
 from models.constants import BODY_COEFFICIENTS, SURFACES
+from models.replay import START_WINDOW_S
 
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
 UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi": "rad", "theta": "rad",
@@ -19,7 +20,6 @@ UNITS = {"alpha": "rad", "beta": "rad", "p": "rps", "q": "rps", "r": "rps", "phi
 # Channels whose bandwidth sets the common filter (when excited): the states.
 BANDWIDTH_CHANNELS = ("alpha", "beta", "p", "q", "r")
 COEFFICIENTS = BODY_COEFFICIENTS  # the diagnosis works on the six body-axis coefficients
-START_WINDOW_S = 0.5
 # The states each group of surfaces drives: a state is maneuver-driven only when a surface of
 # its group moved (a symmetric airframe's pitch maneuver leaves β, p and r at their noise).
 DRIVEN_BY = {"alpha": ("de",), "q": ("de",), "theta": ("de",), "V": ("de",),

@@ -7,6 +7,7 @@ import json
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -14,7 +15,7 @@ from scipy import signal
 
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
-from harness.diagnosis import refine
+from harness.diagnosis import levels, refine
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason
@@ -24,7 +25,7 @@ from models.aircraft import MODELS, Aircraft, is_xml_model, nominal_root
 from models.hidden import HiddenEffect, hidden_root
 from models.flight import FlightError
 from models.mass import MassProperties, mass_root
-from models.replay import initial_condition, replay
+from models.replay import initial_condition, replay, steady_start
 from models.trim import TrimError
 
 SURFACES = ("de", "da", "dr")
@@ -308,43 +309,70 @@ def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
     return initial_condition(p.t, ch["V"], ch["alpha"], ch.get("h"))
 
 
-def _replay_before(p: Prepared, aircraft: Aircraft, analysis: Analysis):
-    """The model as given, replayed over one maneuver: ``(history, None)`` or ``(None, why)``."""
-    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
+def _replay_surfaces(p: Prepared) -> dict[str, np.ndarray]:
+    """The smoothed surfaces the replay is driven by, each starting at its raw start level
+    (:func:`models.replay.steady_start`): the smoothed first sample carries the filter's end
+    effects and the noise, which the replay would hold as a constant deflection."""
+    return {s: steady_start(p.smooth[s], p.t, level_of=p.raw[s]) for s in SURFACES if s in p.smooth}
+
+
+class Replayed(NamedTuple):
+    """One replay of a maneuver: its outputs by quantity (None when it could not be flown),
+    the surface-level offsets fitted (:mod:`harness.diagnosis.levels`, rad) and why it failed."""
+
+    outputs: dict[str, np.ndarray] | None
+    levels: dict[str, float]
+    failed: str | None = None
+
+
+def _fitted_replay(p: Prepared, fly) -> Replayed:
+    """``fly`` (surfaces -> history) over ``p``'s surfaces with their levels fitted
+    (:func:`levels.fit_levels`); a trim or flight error is reported, not raised."""
+    surfaces = _replay_surfaces(p)
+    bounds = {s: levels.level_bound(p.raw[s], p.smooth[s], p.noise_std.get(s, 0.0), p.dt) for s in surfaces}
+    floors = {c: max(p.noise_std.get(c, 0.0), 1e-9) for c in OUTPUTS if c in p.smooth}
     try:
-        return replay(aircraft, analysis.ic, p.t, surfaces)[0], None
+        sim, offsets = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors,
+                                         _inner(p))
     except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
-        return None, str(exc)
+        return Replayed(None, {}, str(exc))
+    return Replayed(sim, offsets)
+
+
+def _replay_before(p: Prepared, aircraft: Aircraft, analysis: Analysis) -> Replayed:
+    """The model as given, replayed over one maneuver."""
+    return _fitted_replay(p, lambda surf: replay(aircraft, analysis.ic, p.t, surf)[0])
 
 
 def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
-              findings: list[Candidate] | None, analysis: Analysis, before=None, refs: dict | None = None):
+              findings: list[Candidate] | None, analysis: Analysis, before: Replayed | None = None,
+              refs: dict | None = None):
     """Replays before/after and fits for one analysed maneuver; on the validation maneuver
     the identification's findings are applied as predictions. ``before`` reuses an earlier
     :func:`_replay_before` of the same maneuver; ``refs`` are the trim references of the added
-    terms (default: the nominal model's trim at the maneuver's start, :func:`models.hidden.hidden_root`)."""
-    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
-    before_hist, before_failed = before if before is not None else _replay_before(p, aircraft, analysis)
-    after_hist, diverged = before_hist, before_failed
+    terms (default: the nominal model's trim at the maneuver's start, :func:`models.hidden.hidden_root`).
+    Each replay fits its own surface levels (:mod:`harness.diagnosis.levels`)."""
+    before = before if before is not None else _replay_before(p, aircraft, analysis)
+    after = before
     winds = _turbulence_winds(p, analysis) if any(f.effect == "turbulence" for f in findings or []) else None
-    if (added or winds is not None) and before_failed is None:
-        try:
-            after_hist, _ = replay(Aircraft(aircraft.model, hidden=added), _true_start(p, added), p.t, surfaces,
-                                   wind_ned_fps=winds, refs=refs)
-        except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient fits still stand
-            after_hist, diverged = None, str(exc)
+    if (added or winds is not None) and before.failed is None:
+        augmented, start = Aircraft(aircraft.model, hidden=added), _true_start(p, added)
+        after = _fitted_replay(p, lambda surf: replay(augmented, start, p.t, surf, wind_ned_fps=winds, refs=refs)[0])
+    before_failed, diverged = before.failed, after.failed
     a = analysis
     before_mm = a.mismatch
     after_mm, n_terms = _after_mismatch(a, findings or [])
     inner = _inner(p)
     nan = {c: np.full(p.n, np.nan) for c in _CHANNEL_COLUMNS}
-    sim_b = _sim_channels(before_hist) if before_hist is not None else nan
-    sim_a = _sim_channels(after_hist) if after_hist is not None else nan
+    sim_b = before.outputs if before.outputs is not None else nan
+    sim_a = after.outputs if after.outputs is not None else nan
     fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner) if before_failed is None else {},
              "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
     raw_after = _mode_notched(p, findings or [])
     fit_a = {"outputs": output_fit(p.smooth, raw_after, sim_a, OUTPUTS, inner) if diverged is None else {},
              "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
+    fit_b["surface_levels_deg"] = {k: float(np.degrees(v)) for k, v in before.levels.items()}
+    fit_a["surface_levels_deg"] = {k: float(np.degrees(v)) for k, v in after.levels.items()}
     if before_failed is not None:
         fit_b["replay_failed"] = f"the model could not replay this maneuver: {before_failed}"
         fit_a["replay_failed"] = fit_b["replay_failed"]
