@@ -20,6 +20,7 @@ be missing: its table or figure is then left out, never guessed.
 """
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import json
 import math
@@ -31,6 +32,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from harness.executors import LocalPool
 from reports import figures_diagnosis as FD
 from reports.figures_diagnosis import CHANNELS, COEFFICIENTS
 from reports.render import KINDS, Report, Section, Table, format_number, format_value
@@ -347,7 +349,10 @@ def findings_table(findings: Sequence[Mapping]) -> Table:
                  "Most significant first, one row per finding with its parameter; estimate and std_error are in "
                  "the units column. t is the selecting test's statistic: for a coefficient error, (estimate − the "
                  "model's value over the maneuver) / std_error; for other terms, estimate / std_error (a spectral "
-                 "peak: −log10 p; turbulence: the gust-to-noise ratio). 'on validation': what the term, at its estimated size, does "
+                 "peak: −log10 p; turbulence: the gust-to-noise ratio). Where the in-the-loop calibration was kept, "
+                 "estimate and std_error are its refined size (the one the augmented model flies with; the "
+                 "equation-error size is in findings.json's equation_error) while t stays the equation-error "
+                 "test's. 'on validation': what the term, at its estimated size, does "
                  "to the validation maneuver's coefficient mismatch (confirmed: drops by 1 % or more; "
                  "contradicted: grows, and the term is left out of the augmented model).")
 
@@ -672,15 +677,23 @@ def before_after_section(data: Mapping, series: Mapping[str, pd.DataFrame], mane
     return Section(f"Before and after: {maneuver}", lines, _figs(table), figures)
 
 
-def diagnosis_sections(diag: DiagnosisOutput) -> list[Section]:
-    """The report's sections, in order."""
+def _before_after_sections(data: Mapping, series: Mapping[str, pd.DataFrame]) -> list[Section]:
+    roles = ("identification", "validation") if has_validation(data, series) else ("identification",)
+    return [before_after_section(data, series, role) for role in roles]
+
+
+def diagnosis_sections(diag: DiagnosisOutput, workers: int = 2) -> list[Section]:
+    """The report's sections, in order. With ``workers`` > 1 the before/after sections (half
+    the figures) are drawn in a second process meanwhile."""
     data, series = diag.data, diag.series
-    scope = scope_section(data)
-    sections = [verdict_section(data)] + ([scope] if scope is not None else []) + [
-                located_section(data, series), candidates_section(data),
-                model_section(data, diag.path), before_after_section(data, series, "identification")]
-    if has_validation(data, series):
-        sections.append(before_after_section(data, series, "validation"))
+    with contextlib.ExitStack() as stack:
+        pending = None
+        if workers > 1:
+            pending = stack.enter_context(LocalPool(1)).pool.submit(_before_after_sections, data, series)
+        scope = scope_section(data)
+        sections = [verdict_section(data)] + ([scope] if scope is not None else []) + [
+                    located_section(data, series), candidates_section(data), model_section(data, diag.path)]
+        sections += pending.result() if pending is not None else _before_after_sections(data, series)
     return sections
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -71,38 +72,58 @@ def _with(ch: dict, name: str, x: np.ndarray) -> dict:
     return out
 
 
+# Corrections are partials of module-level functions, so a SensorParameter (and an analysis
+# holding one) can be sent to another process.
+def _bias_corrected(c: str, ch: dict, p: Prepared, th: float) -> dict:
+    return _with(ch, c, ch[c] - th)
+
+
+def _scale_corrected(c: str, ch: dict, p: Prepared, th: float) -> dict:
+    return _with(ch, c, ch[c] / (1.0 + th))
+
+
+def _skew_corrected(c: str, ch: dict, p: Prepared, th: float) -> dict:
+    # the channel lags by τ: x_true(t) = x_meas(t + τ) ≈ x_meas + τ ẋ
+    return _with(ch, c, ch[c] + th * p.differentiate(ch[c]))
+
+
+def _accel_offset_corrected(axis: int, ch: dict, p: Prepared, th: float) -> dict:
+    r = np.zeros(3)
+    r[axis] = th
+    w = np.stack([ch["p"], ch["q"], ch["r"]], axis=-1)
+    wd = np.stack([p.differentiate(ch["p"]), p.differentiate(ch["q"]), p.differentiate(ch["r"])], axis=-1)
+    extra = (np.cross(wd, r) + np.cross(w, np.cross(w, r))) / G0
+    out = dict(ch)
+    for i, c in enumerate(("ax", "ay", "az")):
+        out[c] = ch[c] - extra[:, i]
+    return out
+
+
+def _vane_corrected(c: str, ch: dict, p: Prepared, th: float) -> dict:
+    # a vane x ft ahead of the c.g.: α_v = α − x q/V, β_v = β + x r/V
+    if c == "alpha":
+        return _with(ch, "alpha", ch["alpha"] + th * ch["q"] / ch["V"])
+    return _with(ch, "beta", ch["beta"] - th * ch["r"] / ch["V"])
+
+
 def _bias(c: str) -> Callable:
-    return lambda ch, p, th: _with(ch, c, ch[c] - th)
+    return partial(_bias_corrected, c)
 
 
 def _scale(c: str) -> Callable:
-    return lambda ch, p, th: _with(ch, c, ch[c] / (1.0 + th))
+    return partial(_scale_corrected, c)
 
 
 def _skew(c: str) -> Callable:
-    # the channel lags by τ: x_true(t) = x_meas(t + τ) ≈ x_meas + τ ẋ
-    return lambda ch, p, th: _with(ch, c, ch[c] + th * p.differentiate(ch[c]))
+    return partial(_skew_corrected, c)
 
 
 def _accel_offset(axis: int) -> Callable:
-    def correct(ch: dict, p: Prepared, th: float) -> dict:
-        r = np.zeros(3)
-        r[axis] = th
-        w = np.stack([ch["p"], ch["q"], ch["r"]], axis=-1)
-        wd = np.stack([p.differentiate(ch["p"]), p.differentiate(ch["q"]), p.differentiate(ch["r"])], axis=-1)
-        extra = (np.cross(wd, r) + np.cross(w, np.cross(w, r))) / G0
-        out = dict(ch)
-        for i, c in enumerate(("ax", "ay", "az")):
-            out[c] = ch[c] - extra[:, i]
-        return out
-    return correct
+    return partial(_accel_offset_corrected, axis)
 
 
 def _vane(c: str) -> Callable:
-    # a vane x ft ahead of the c.g.: α_v = α − x q/V, β_v = β + x r/V
-    if c == "alpha":
-        return lambda ch, p, th: _with(ch, "alpha", ch["alpha"] + th * ch["q"] / ch["V"])
-    return lambda ch, p, th: _with(ch, "beta", ch["beta"] - th * ch["r"] / ch["V"])
+    return partial(_vane_corrected, c)
 
 
 def sensor_parameters(p: Prepared) -> tuple[SensorParameter, ...]:

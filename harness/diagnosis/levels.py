@@ -11,13 +11,16 @@ condition).
 So, as output-error practice estimates instrument biases, the levels are estimated: one replay
 per surface gives the outputs' sensitivity to its level, a weighted least-squares step the levels
 that best fit the recorded outputs, bounded by what the start window's noise and motion allow
-(:func:`level_bound`). Each model (the one given, the augmented one) gets its own levels, so a
-before/after comparison stays fair; the levels are reported with the fit.
+(:func:`level_bound`), and the outputs at those levels follow to first order (the offsets are a
+few hundredths of a degree). Each model (the one given, the augmented one) gets its own levels,
+so a before/after comparison stays fair; the augmented model reuses the given model's
+sensitivities (one replay, not four); the levels are reported with the fit.
 """
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from typing import NamedTuple
 
 import numpy as np
 
@@ -57,17 +60,42 @@ def _stack(sim: Mapping[str, np.ndarray], channels: tuple[str, ...], inner: slic
     return np.concatenate([np.asarray(sim[c], dtype=float)[inner] for c in channels])
 
 
+class LevelFit(NamedTuple):
+    """A replay with its surface levels fitted: the outputs by quantity, the offsets (rad) added
+    to each fitted surface, and each surface's sensitivity (output per rad of level, by
+    quantity) for another model of the same maneuver to reuse."""
+
+    outputs: dict[str, np.ndarray]
+    offsets: dict[str, float]
+    sensitivities: dict[str, dict[str, np.ndarray]]
+
+
+def level_sensitivities(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.ndarray]],
+                        surfaces: Mapping[str, np.ndarray], y0: Mapping[str, np.ndarray],
+                        fitted: list[str]) -> dict[str, dict[str, np.ndarray]]:
+    """Per surface of ``fitted``, d(output)/d(level) by forward difference over
+    :data:`LEVEL_STEP_RAD` (one replay each), for every output ``y0`` has."""
+    out = {}
+    for s in fitted:
+        ys = fly(_shifted(surfaces, {s: LEVEL_STEP_RAD}))
+        out[s] = {c: (np.asarray(ys[c], dtype=float) - np.asarray(y0[c], dtype=float)) / LEVEL_STEP_RAD
+                  for c in y0 if c in ys}
+    return out
+
+
 def fit_levels(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.ndarray]],
                surfaces: Mapping[str, np.ndarray], bounds: Mapping[str, float],
                measured: Mapping[str, np.ndarray], floors: Mapping[str, float], inner: slice,
-               base: Mapping[str, np.ndarray] | None = None
-               ) -> tuple[Mapping[str, np.ndarray], dict[str, float]]:
-    """The replay with each surface's level fitted (one Gauss-Newton step, kept only when it
-    lowers the cost).
+               sensitivities: Mapping[str, Mapping[str, np.ndarray]] | None = None) -> LevelFit:
+    """The replay with each surface's level fitted: one weighted least-squares step on the
+    outputs' sensitivities, the outputs then predicted to first order (the offsets are a few
+    hundredths of a degree), kept only when it lowers the weighted cost.
 
     Parameters
     ----------
-    fly : surfaces -> simulated outputs by quantity; raises whatever the replay raises.
+    fly : surfaces -> simulated outputs by quantity; raises whatever the replay raises (the
+        replay at the recorded levels is not caught; a sensitivity replay that fails leaves
+        the levels as recorded).
     surfaces : the recorded surfaces as the replay is given them.
     bounds : per surface, the largest |offset| (rad) (:func:`level_bound`); surfaces with 0
         are not fitted.
@@ -75,33 +103,31 @@ def fit_levels(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.ndarray]],
     floors : per output, the smallest RMS its weight assumes (its noise level): each output is
         weighted by 1/max(RMS error at the recorded levels, floor).
     inner : the samples compared (the ends of a smoothed record left out).
-    base : the outputs already flown at the recorded levels, if any.
-
-    Returns
-    -------
-    (outputs, offsets) : the simulated outputs at the fitted levels and the offsets (rad) added
-        to each fitted surface ({} when none was fitted or the step did not lower the cost).
+    sensitivities : another model's :func:`level_sensitivities` of the same maneuver (the
+        augmented model reuses the given one's: one replay instead of one per surface more).
     """
-    y0 = base if base is not None else fly(dict(surfaces))
-    channels = tuple(c for c in floors if c in measured and c in y0
-                     and np.all(np.isfinite(np.asarray(y0[c])[inner])))
+    y0 = {c: np.asarray(v, dtype=float) for c, v in fly(dict(surfaces)).items()}
+    channels = tuple(c for c in floors if c in measured and c in y0 and np.all(np.isfinite(y0[c][inner])))
     fitted = [s for s in surfaces if bounds.get(s, 0.0) > 0.0]
     if not channels or not fitted:
-        return y0, {}
+        return LevelFit(y0, {}, {})
+    try:
+        sens = dict(sensitivities) if sensitivities is not None else level_sensitivities(fly, surfaces, y0, fitted)
+    except (FlightError, TrimError):  # a level the step makes diverge: the recorded levels stand
+        return LevelFit(y0, {}, {})
+    fitted = [s for s in fitted if s in sens and all(c in sens[s] for c in channels)]
+    if not fitted:
+        return LevelFit(y0, {}, {})
     z = _stack(measured, channels, inner)
     r0 = z - _stack(y0, channels, inner)
     w = np.concatenate([np.full(len(part), 1.0 / max(float(np.sqrt(np.mean(part ** 2))), floors[c], 1e-12))
                         for c, part in zip(channels, np.split(r0, len(channels)))])
-    try:
-        y0s = z - r0
-        cols = [(_stack(fly(_shifted(surfaces, {s: LEVEL_STEP_RAD})), channels, inner) - y0s) / LEVEL_STEP_RAD
-                for s in fitted]
-        step, *_ = np.linalg.lstsq(np.column_stack(cols) * w[:, None], r0 * w, rcond=None)
-        offsets = {s: float(np.clip(v, -bounds[s], bounds[s])) for s, v in zip(fitted, step)}
-        y1 = fly(_shifted(surfaces, offsets))
-    except (FlightError, TrimError):  # a level the step makes diverge: the recorded levels stand
-        return y0, {}
-    r1 = z - _stack(y1, channels, inner)
-    if not np.all(np.isfinite(r1)) or np.sum((r1 * w) ** 2) >= np.sum((r0 * w) ** 2):
-        return y0, {}
-    return y1, offsets
+    cols = np.column_stack([_stack(sens[s], channels, inner) for s in fitted])
+    if not np.all(np.isfinite(cols)):
+        return LevelFit(y0, {}, sens)
+    step, *_ = np.linalg.lstsq(cols * w[:, None], r0 * w, rcond=None)
+    off = np.clip(step, [-bounds[s] for s in fitted], [bounds[s] for s in fitted])
+    if np.sum(((r0 - cols @ off) * w) ** 2) >= np.sum((r0 * w) ** 2):
+        return LevelFit(y0, {}, sens)
+    outputs = {c: y + sum(o * sens[s][c] for s, o in zip(fitted, off) if c in sens[s]) for c, y in y0.items()}
+    return LevelFit(outputs, {s: float(o) for s, o in zip(fitted, off)}, sens)

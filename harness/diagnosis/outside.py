@@ -319,7 +319,7 @@ def cases() -> tuple[OutsideCase, ...]:
         ("L", "lateral", H("sensor_bias", 1.0 * DEG, channel="beta"), "bias_beta", 1.0 * DEG, "beta"),
         ("F", "lateral", H("sensor_bias", 0.5 * DEG, channel="r"), "bias_r", 0.5 * DEG, "r"),
         ("S", "lateral", H("sensor_scale", 0.15, channel="beta"), "scale_beta", 0.15, "beta"),
-        ("M", "lateral", H("sensor_offset", 0.0, position_ft=(0.0, 6.0, 0.0)), "offset_y", 6.0, "az"),
+        ("M", "lateral", H("sensor_offset", 0.0, position_ft=(0.0, 6.0, 0.0)), "offset_y", 6.0, "az"),  # ṗ·y on a_z
         ("H", "lateral", H("sensor_time_skew", 0.04, channel="p"), "skew_p", 0.04, "p"),
         # --- F-16, three-axis
         ("S", "three_axis", H("cross_coupling", -2.0, coefficient="Cl"), "Cl_alpha_beta", -2.0, "p"),

@@ -14,6 +14,7 @@ import pandas as pd
 from scipy import signal
 
 from harness.atomic import jsonable, write_atomic, write_text_atomic
+from harness.executors import LocalPool
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
@@ -318,25 +319,36 @@ def _replay_surfaces(p: Prepared) -> dict[str, np.ndarray]:
 
 class Replayed(NamedTuple):
     """One replay of a maneuver: its outputs by quantity (None when it could not be flown),
-    the surface-level offsets fitted (:mod:`harness.diagnosis.levels`, rad) and why it failed."""
+    the surface-level offsets fitted (:mod:`harness.diagnosis.levels`, rad), the outputs'
+    sensitivities to the levels, and why it failed."""
 
     outputs: dict[str, np.ndarray] | None
     levels: dict[str, float]
+    sensitivities: dict = {}
     failed: str | None = None
 
 
-def _fitted_replay(p: Prepared, fly) -> Replayed:
+def _fitted_replay(p: Prepared, fly, sensitivities: dict | None = None) -> Replayed:
     """``fly`` (surfaces -> history) over ``p``'s surfaces with their levels fitted
-    (:func:`levels.fit_levels`); a trim or flight error is reported, not raised."""
+    (:func:`levels.fit_levels`; ``sensitivities`` of another model of the same maneuver are
+    reused); a trim or flight error is reported, not raised."""
     surfaces = _replay_surfaces(p)
     bounds = {s: levels.level_bound(p.raw[s], p.smooth[s], p.noise_std.get(s, 0.0), p.dt) for s in surfaces}
     floors = {c: max(p.noise_std.get(c, 0.0), 1e-9) for c in OUTPUTS if c in p.smooth}
     try:
-        sim, offsets = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors,
-                                         _inner(p))
+        fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, _inner(p),
+                                sensitivities or None)
     except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
-        return Replayed(None, {}, str(exc))
-    return Replayed(sim, offsets)
+        return Replayed(None, {}, {}, str(exc))
+    return Replayed(fit.outputs, fit.offsets, fit.sensitivities)
+
+
+def _analysed(rec, role: str, aircraft: Aircraft) -> tuple[Prepared, Analysis, Replayed]:
+    """One maneuver prepared, analysed and replayed as the model is (a unit of work a second
+    process can take)."""
+    p = prepare(rec, role)
+    a = analyse(p, aircraft, initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude))
+    return p, a, _replay_before(p, aircraft, a)
 
 
 def _replay_before(p: Prepared, aircraft: Aircraft, analysis: Analysis) -> Replayed:
@@ -737,21 +749,27 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
     DiagnosisError
         For an unknown model; recording, trim and flight errors name their cause themselves.
     """
-    with incomplete_marker(Path(out)) as folder:
+    with incomplete_marker(Path(out)) as folder, contextlib.ExitStack() as stack:
+        # a second process takes the validation maneuver's share (analysis, replays) meanwhile
+        pool = stack.enter_context(LocalPool(1)) if validation is not None and calibrate_workers > 1 else None
         return _diagnose(model, recording, folder, validation, mass=mass, calibrate=calibrate,
-                         workers=calibrate_workers)
+                         workers=calibrate_workers, pool=pool)
 
 
 def _fly_all(maneuvers: dict, aircraft: Aircraft, added: tuple[HiddenEffect, ...], modelled: list[Candidate],
-             befores: dict, refs: dict | None = None) -> dict:
+             befores: dict, refs: dict | None = None, pool: LocalPool | None = None) -> dict:
     """:func:`_maneuver` for each role of ``maneuvers`` (role -> (prepared, analysis)), the
-    model as given flown once (``befores``): role -> (analysis, fit before, fit after, series)."""
-    return {role: _maneuver(pm, aircraft, added, modelled, am, befores[role], refs)
-            for role, (pm, am) in maneuvers.items()}
+    model as given flown once (``befores``): role -> (analysis, fit before, fit after, series).
+    With a ``pool``, the validation maneuver is flown in its process meanwhile."""
+    pending = {role: pool.pool.submit(_maneuver, pm, aircraft, added, modelled, am, befores[role], refs)
+               for role, (pm, am) in maneuvers.items() if pool is not None and role == "validation"}
+    out = {role: _maneuver(pm, aircraft, added, modelled, am, befores[role], refs)
+           for role, (pm, am) in maneuvers.items() if role not in pending}
+    return out | {role: fut.result() for role, fut in pending.items()}
 
 
 def _refine(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int, maneuvers: dict, befores: dict,
-            modelled: list[Candidate], added: tuple[HiddenEffect, ...], flown: dict):
+            modelled: list[Candidate], added: tuple[HiddenEffect, ...], flown: dict, pool: LocalPool | None = None):
     """The last step: calibrate the kept aircraft terms in the loop and keep the calibrated sizes
     only when they fit at least as well (:func:`refine.decide`).
 
@@ -785,7 +803,7 @@ def _refine(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int,
     added_cal = refine.refined_terms(added, sizes)
     # the calibrated sizes belong to the calibration's term references (its unadjusted model's
     # trim at the recording's start): the augmented model is flown and written with them
-    flown_cal = _fly_all(maneuvers, aircraft, added_cal, modelled_cal, befores, dict(cal.refs))
+    flown_cal = _fly_all(maneuvers, aircraft, added_cal, modelled_cal, befores, dict(cal.refs), pool)
     fits_ee = {r: v[2] for r, v in flown.items()}
     fits_cal = {r: v[2] for r, v in flown_cal.items()}
     used, reason, figures = refine.decide(cal, fits_ee, fits_cal, refine.affected_outputs(terms))
@@ -797,7 +815,7 @@ def _refine(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int,
 
 
 def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str,
-              calibrate: bool = True, workers: int = 2) -> dict:
+              calibrate: bool = True, workers: int = 2, pool: LocalPool | None = None) -> dict:
     t0 = time.perf_counter()
     aircraft = _aircraft(model)
     rec = read_recording(recording)
@@ -805,21 +823,27 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         aircraft = _with_recorded_mass(aircraft, rec)
     elif mass != "model":
         raise DiagnosisError(f"mass must be 'model' or 'recording', not {mass!r}")
+    recs = {"identification": rec}
+    if validation is not None:
+        recs["validation"] = read_recording(validation)
+    pending = None
+    if validation is not None and pool is not None:
+        pending = pool.pool.submit(_analysed, recs["validation"], "validation", aircraft)
     p = prepare(rec, "identification")
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude)
     a = analyse(p, aircraft, ic)
     check_model_represents(a, model)
+    befores = {"identification": _replay_before(p, aircraft, a)}
+    if validation is not None:
+        pv, av, befores["validation"] = (pending.result() if pending is not None else
+                                         _analysed(recs["validation"], "validation", aircraft))
     findings = _findings(a)
     checks: dict[int, dict | None] = {}
     unconfirmed: list[Candidate] = []
-    av = None
-    recs = {"identification": rec}
     if validation is not None:
-        recs["validation"] = read_recording(validation)
-        pv = prepare(recs["validation"], "validation")
-        av = analyse(pv, aircraft, initial_condition(pv.t, pv.smooth["V"], pv.smooth["alpha"], pv.altitude))
         checks = {id(f): validation_check(av, f) for f in findings}
     else:
+        av = None
         checks = {id(f): _undecided(f) for f in findings}
     # a finding is kept only when the validation maneuver confirms it (or cannot test it:
     # a gust level, a spectral peak); the others are reported apart, not as findings
@@ -831,13 +855,12 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     # the recording as prepared (``a.prepared`` carries the sensor corrections; fits are
     # against what was recorded)
     maneuvers = {"identification": (p, a)} | ({"validation": (pv, av)} if av is not None else {})
-    befores = {role: _replay_before(pm, aircraft, am) for role, (pm, am) in maneuvers.items()}
-    flown = _fly_all(maneuvers, aircraft, added, modelled, befores)
+    flown = _fly_all(maneuvers, aircraft, added, modelled, befores, pool=pool)
     calibration = {"used": False, "reason": "not asked for (calibrate=False, --no-calibrate)"}
     if calibrate:
         t1 = time.perf_counter()
         calibration, modelled, added, flown = _refine(model, recs, aircraft, mass, workers, maneuvers, befores,
-                                                      modelled, added, flown)
+                                                      modelled, added, flown, pool)
         timing["calibration"] = time.perf_counter() - t1
     _, fb_id, fa_id, series_id = flown["identification"]
     fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
@@ -889,13 +912,21 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
 
 def _with_calibration(d: dict, calibration: dict) -> dict:
     """A finding's dict with its calibrated size and standard error (``calibrated``: the size in
-    the model when the calibration was used, else only reported), the equation-error fits
-    beside the calibrated ones, and a sentence in the explanation."""
+    the model when the calibration was used, else only reported), and a sentence in the
+    explanation. When used, the calibrated size is the finding's ``estimate`` and
+    ``std_error`` (and a coefficient error's ``change``): the equation-error ones move to
+    ``equation_error``, their fits to ``fit_after_equation_error``."""
     own = (calibration.get("findings") or {}).get(d["parameter"])
     if own is None:
         return d
     d["calibrated"] = own | {"used": bool(calibration["used"])}
     if calibration["used"]:
+        # the headline is the size the augmented model flies with; the equation-error one stays beside it
+        d["equation_error"] = {"estimate": d["estimate"], "std_error": d["std_error"]}
+        d["estimate"], d["std_error"] = float(own["estimate"]), float(own["std_error"])
+        if "change" in d["evidence"]:
+            d["equation_error"]["change"] = d["evidence"]["change"]
+            d["evidence"]["change"] = float(own["size"])
         d["fit_after_equation_error"] = calibration["fit_after_equation_error"]
         d["explanation"] += (f" Refined with JSBSim in the loop: {own['estimate']:.4g} ± {own['std_error']:.2g}, the "
                              "size the augmented model flies with.")

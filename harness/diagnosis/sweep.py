@@ -119,7 +119,7 @@ def cases() -> tuple[SweepCase, ...]:
                       H("sensor_offset", pos[0], position_ft=pos), "sensor_offset", "x_accelerometer", pos[0], "az"))
     for y in (3.0, 6.0):
         out.append(_c(f"offset_acc_y{y:g}", H("sensor_offset", 0.0, position_ft=(0.0, y, 0.0)), "sensor_offset",
-                      "offset_y", y, "ay"))
+                      "offset_y", y, "az"))  # a lateral offset moves a_z most: ṗ·y (a_y only by (p² + r²)·y)
     for chan, tau in (("alpha", 0.04), ("alpha", 0.08), ("q", 0.04), ("az", 0.04), ("az", 0.08)):
         out.append(_c(f"skew_{chan}_{tau:g}", H("sensor_time_skew", tau, channel=chan), "sensor_time_skew",
                       f"skew_{chan}", tau, chan))
@@ -176,15 +176,15 @@ def size_right(first: dict, expect: str, truth: float, named: bool) -> bool | No
 
 def validation_drop(first: dict, channel: str | None, named: bool) -> tuple[bool | None, list | None]:
     """Criterion d: the validation RMS of the affected ``channel`` drops by at least
-    :data:`BAR_DROP` with the equation-error sizes (as before the calibration step), for the
-    right finding; with the (before, after) RMS pair. None when no channel is scored."""
+    :data:`BAR_DROP` with the augmented model the diagnosis reports (its calibrated sizes when
+    it kept them), for the right finding; with the (before, after) RMS pair. None when no
+    channel is scored."""
     if not channel:
         return None, None
     if "validation" not in first.get("fit_before", {}) or first["effect"] == "none":
         return False, None
     before = first["fit_before"]["validation"]["outputs"].get(channel, {}).get("rms")
-    ee = first.get("fit_after_equation_error") or first["fit_after"]
-    after = ee["validation"].get("outputs", {}).get(channel, {}).get("rms")
+    after = first["fit_after"]["validation"].get("outputs", {}).get(channel, {}).get("rms")
     if not before or after is None:
         return False, None
     return bool(named and 1.0 - after / before >= BAR_DROP), [before, after]
