@@ -232,3 +232,15 @@ def test_a_gyro_skew_no_coefficient_term_imitates_is_named_on_two_tests(tmp_path
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
     assert abs(row["first"]["estimate"] - c.truth) <= 0.25 * c.truth
+
+
+def test_a_beta_vane_scale_is_corroborated_along_the_vane(tmp_path):
+    """Outside case S_lateral (β-vane scale 0.15): the kinematics see it at t ~ 5.5 beside an
+    r-gyro scale at -5.4; along the inertial sideslip the model never sees the vane, so the
+    vane's signature is taken along the vane itself: C_Y, C_l and C_n agree on it and it is
+    named (size within 25 %), the gyro scale is not."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "S_lateral_sensor_scale_scale_beta_0.15")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
+    assert abs(row["first"]["estimate"] - c.truth) <= 0.25 * c.truth

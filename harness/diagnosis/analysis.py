@@ -207,8 +207,8 @@ def _corrected(p: Prepared, kin: KinematicResult, values: dict[str, float]) -> P
     return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
 
 
-def model_states(p: Prepared, inertial_from: Prepared | None = None) -> tuple[dict[str, np.ndarray],
-                                                                              dict[str, np.ndarray]]:
+def model_states(p: Prepared, inertial_from: Prepared | None = None,
+                 vane_beta: bool = False) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """The states and surfaces the model is evaluated along.
 
     A state the maneuver did not drive is held at its start: evaluated along its noise, the
@@ -229,7 +229,7 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None) -> tuple[di
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven:
             states[k] = np.full(p.n, p.start[k])
-    if inertial_beta(p):
+    if inertial_beta(p) and not vane_beta:
         src = inertial_from or p
         states["beta"] = inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)["beta"]
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
@@ -254,10 +254,11 @@ class ModelAlong(NamedTuple):
 
 
 def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
-                inertial_from: Prepared | None = None) -> ModelAlong:
+                inertial_from: Prepared | None = None, vane_beta: bool = False) -> ModelAlong:
     """The measured coefficients and the model's along the states of :func:`model_states`
-    (its inertial sideslip integrated from ``inertial_from``, default ``p``)."""
-    states, surfaces = model_states(p, inertial_from)
+    (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
+    sideslip with ``vane_beta``)."""
+    states, surfaces = model_states(p, inertial_from, vane_beta)
     alphadot = p.deriv["alpha"] if "alpha" in p.driven else None
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
@@ -615,13 +616,27 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
     terms whose parameter is not in ``skip`` (and its nuisances)."""
     inner = _inner(p)
 
+    vane: list[dict[str, np.ndarray]] = []  # the mismatch along the β vane, made when first asked
+
     def ratios(name: str, value: float, skip: frozenset[str] = frozenset()) -> dict:
         # the inertial sideslip stays the one integrated from p: it is built from the same
         # instruments as the kinematic check, so letting it follow the correction would make
         # the two tests one
+        if _beta_vane_parameter(name) and inertial_beta(p):
+            # a β-vane error cannot reach a mismatch along the inertial sideslip: its signature
+            # is taken along the vane (whose slow wander the colored-residual fit allows for)
+            if not vane:
+                vane.append(model_along(p, aircraft, ic, vane_beta=True).mismatch())
+            changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, vane_beta=True).mismatch()
+            return _axis_ratios(cands, step, inner, vane[0], changed, skip)
         changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
         return _axis_ratios(cands, step, inner, mismatch, changed, skip)
     return ratios
+
+
+def _beta_vane_parameter(name: str) -> bool:
+    """A sensor parameter of the β vane (its bias, scale, skew or position)."""
+    return name in ("bias_beta", "scale_beta", "skew_beta", "vane_beta_x")
 
 
 def _axis_ratios(cands: list[Candidate], step: _Stepwise, inner: slice, base: dict[str, np.ndarray],
