@@ -75,6 +75,7 @@ def test_assumptions_name_the_stand_ins_for_missing_channels(tmp_path):
     # the density altitude of q̄ and V in JSBSim's standard atmosphere is the flown 20,000 ft
     assert abs(float(by_item["altitude"]["stood_in_by"].split("(")[1].split(" ft")[0]) - 20_000) < 50
     assert "model's trim thrust" in by_item["thrust"]["stood_in_by"] and "lbf" in by_item["thrust"]["stood_in_by"]
+    assert "surface_levels_deg" in by_item["surface levels (replays)"]["stood_in_by"]
     assert _effects(result) == ["none"]  # a clean recording of the model, made elsewhere in the envelope
     written = json.loads((tmp_path / "out" / "findings.json").read_text())
     assert written["assumptions"] and written["not_checked"]

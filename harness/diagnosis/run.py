@@ -678,6 +678,10 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
     if trim.held:
         for surface, info in trim.held.items():
             out.append({"item": f"model trim ({surface})", "missing": "-", "stood_in_by": info["reason"]})
+    out.append({"item": "surface levels (replays)", "missing": "-",
+                "stood_in_by": ("each surface moves by its recorded change from a start level fitted, per replay, "
+                                "within the noise of its first 0.5 s (fit_before/fit_after: surface_levels_deg; "
+                                "harness/diagnosis/levels.py)")})
     return out
 
 
