@@ -69,10 +69,10 @@ def test_a_step_that_diverges_keeps_the_recorded_levels():
 def test_level_bound_from_noise_and_motion():
     dt, sigma = 0.02, math.radians(0.05)
     quiet = np.zeros(100)
-    assert level_bound(quiet, quiet, sigma, dt) == pytest.approx(LEVEL_BOUND_SIGMAS * 1.25 * sigma / 5.0)
-    assert level_bound(quiet, quiet, 0.0, dt) == 0.0
+    assert level_bound(quiet, sigma, dt) == pytest.approx(LEVEL_BOUND_SIGMAS * 1.25 * sigma / 5.0)
+    assert level_bound(quiet, 0.0, dt) == 0.0
     moving = np.linspace(0.0, 0.01, 100)
-    assert level_bound(moving, moving, 0.0, dt) == pytest.approx(0.5 * moving[24])
+    assert level_bound(moving, 0.0, dt) == pytest.approx(0.5 * moving[24])
 
 
 def test_start_level_is_the_median_of_the_start_window():

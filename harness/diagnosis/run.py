@@ -319,28 +319,24 @@ def _replay_surfaces(p: Prepared) -> dict[str, np.ndarray]:
 
 class Replayed(NamedTuple):
     """One replay of a maneuver: its outputs by quantity (None when it could not be flown),
-    the surface-level offsets fitted (:mod:`harness.diagnosis.levels`, rad), the outputs'
-    sensitivities to the levels, and why it failed."""
+    the surface-level offsets fitted (:mod:`harness.diagnosis.levels`, rad) and why it failed."""
 
     outputs: dict[str, np.ndarray] | None
     levels: dict[str, float]
-    sensitivities: dict = {}
     failed: str | None = None
 
 
-def _fitted_replay(p: Prepared, fly, sensitivities: dict | None = None) -> Replayed:
+def _fitted_replay(p: Prepared, fly) -> Replayed:
     """``fly`` (surfaces -> history) over ``p``'s surfaces with their levels fitted
-    (:func:`levels.fit_levels`; ``sensitivities`` of another model of the same maneuver are
-    reused); a trim or flight error is reported, not raised."""
+    (:func:`levels.fit_levels`); a trim or flight error is reported, not raised."""
     surfaces = _replay_surfaces(p)
-    bounds = {s: levels.level_bound(p.raw[s], p.smooth[s], p.noise_std.get(s, 0.0), p.dt) for s in surfaces}
+    bounds = {s: levels.level_bound(p.smooth[s], p.noise_std.get(s, 0.0), p.dt) for s in surfaces}
     floors = {c: max(p.noise_std.get(c, 0.0), 1e-9) for c in OUTPUTS if c in p.smooth}
     try:
-        fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, _inner(p),
-                                sensitivities or None)
+        fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, _inner(p))
     except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
-        return Replayed(None, {}, {}, str(exc))
-    return Replayed(fit.outputs, fit.offsets, fit.sensitivities)
+        return Replayed(None, {}, str(exc))
+    return Replayed(fit.outputs, fit.offsets)
 
 
 def _analysed(rec, role: str, aircraft: Aircraft) -> tuple[Prepared, Analysis, Replayed]:
