@@ -219,7 +219,7 @@ def _add_diagnose(sub) -> None:
                         "error, as sidbench calibrate), keeping the calibrated sizes only when the identification "
                         "fit and the validation RMS of the outputs they drive are at least as good (default: on; "
                         "surfaces held sample to sample for a simulated recording, interpolated for flight data)")
-    g.add_argument("--workers", type=int, default=2, help="processes flying the calibration's flights (default 2)")
+    g.add_argument("--workers", type=int, default=2, help="processes (default 2): the calibration's flights; above 1 the validation maneuver is also analysed, replayed and drawn in a second process (same results)")
     g.set_defaults(func=lambda a: _commands().cmd_diagnose(a))
 
 

@@ -79,7 +79,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from reports.diagnosis_report import write_diagnosis_report
     result = diagnose(args.model, args.recording, args.out, args.validation, mass=args.mass,
                       calibrate=getattr(args, "calibrate", True), calibrate_workers=getattr(args, "workers", 2))
-    html = write_diagnosis_report(Path(args.out))
+    html = write_diagnosis_report(Path(args.out), getattr(args, "workers", 2))
     for f in result["findings"]:
         if f["effect"] == "none":
             print(f"none: {f['explanation']}")

@@ -727,13 +727,15 @@ def _numbers(diag: DiagnosisOutput) -> dict:
     return {"report": "diagnosis", **diag.data, "series": shapes}
 
 
-def diagnosis_report(out_dir: Path) -> Report:
+def diagnosis_report(out_dir: Path, workers: int = 2) -> Report:
     """The report of a ``sidbench diagnose`` output folder.
 
     Parameters
     ----------
     out_dir : Path
         The folder holding ``findings.json`` and ``series/``.
+    workers : int
+        Above 1, the before/after figures are drawn in a second process (same report).
 
     Returns
     -------
@@ -743,11 +745,11 @@ def diagnosis_report(out_dir: Path) -> Report:
     """
     diag = read_diagnosis(out_dir)
     return Report(title=_title(diag.data), kind=KIND, provenance=_provenance(diag),
-                  summary=tuple(summary_lines(diag.data)), sections=tuple(diagnosis_sections(diag)),
+                  summary=tuple(summary_lines(diag.data)), sections=tuple(diagnosis_sections(diag, workers)),
                   numbers=_numbers(diag), status="findings" if _real(_findings(diag.data)) else "ok")
 
 
-def write_diagnosis_report(out_dir: Path) -> Path:
+def write_diagnosis_report(out_dir: Path, workers: int = 2) -> Path:
     """Write ``report.html``, ``report.md`` and ``report.json`` into the diagnosis folder.
 
     Each file is written atomically (a temporary file renamed into place).
@@ -756,6 +758,8 @@ def write_diagnosis_report(out_dir: Path) -> Path:
     ----------
     out_dir : Path
         The folder ``sidbench diagnose`` wrote.
+    workers : int
+        Processes drawing the figures (:func:`diagnosis_sections`).
 
     Returns
     -------
@@ -763,4 +767,4 @@ def write_diagnosis_report(out_dir: Path) -> Path:
         The HTML report's path, ``out_dir / 'report.html'``.
     """
     from reports.commands import write_all  # here, so that commands may import this module
-    return write_all(diagnosis_report(Path(out_dir)), Path(out_dir), "report")
+    return write_all(diagnosis_report(Path(out_dir), workers), Path(out_dir), "report")
