@@ -14,13 +14,13 @@ import pandas as pd
 from scipy import signal
 
 from harness.atomic import jsonable, write_atomic, write_text_atomic
-from harness.executors import LocalPool
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
 from harness.diagnosis.analysis import Analysis, Candidate, analyse
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
+from harness.executors import LocalPool
 from harness.recording_io import read_recording
 from models.aircraft import MODELS, Aircraft, is_xml_model, nominal_root
 from models.hidden import HiddenEffect, hidden_root
