@@ -23,6 +23,12 @@ from models.constants import BODY_COEFFICIENTS, SURFACES
 
 START_WINDOW_S = 0.5  # the recording's start: the span its initial condition and surface levels average
 
+
+def start_samples(t: np.ndarray, window_s: float = START_WINDOW_S) -> int:
+    """How many samples of ``t`` the first ``window_s`` seconds hold (at least one)."""
+    return max(1, int(math.ceil(window_s / float(np.median(np.diff(t))))))
+
+
 @dataclass(frozen=True)
 class InitialCondition:
     """Where the recording starts: the model is trimmed wings-level here."""
@@ -103,8 +109,7 @@ def replay(aircraft: Aircraft, ic: InitialCondition, t: np.ndarray, surfaces: Ma
 def start_level(x: np.ndarray, t: np.ndarray, window_s: float = START_WINDOW_S) -> float:
     """The level ``x`` starts at: the median of its first ``window_s`` seconds (robust to an
     input that begins inside the window)."""
-    k = max(1, int(math.ceil(window_s / float(np.median(np.diff(t))))))
-    return float(np.median(np.asarray(x, dtype=float)[:k]))
+    return float(np.median(np.asarray(x, dtype=float)[:start_samples(t, window_s)]))
 
 
 def steady_start(x: np.ndarray, t: np.ndarray, window_s: float = START_WINDOW_S,
@@ -225,6 +230,6 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
 def initial_condition(t: np.ndarray, V: np.ndarray, alpha: np.ndarray, h: np.ndarray | None,
                       window_s: float = START_WINDOW_S) -> InitialCondition:
     """The recording's initial condition: means over its first ``window_s`` seconds."""
-    k = max(1, int(math.ceil(window_s / float(np.median(np.diff(t))))))
+    k = start_samples(t, window_s)
     return InitialCondition(h_ft=float(np.mean(h[:k])) if h is not None else 10_000.0,
                             V_fps=float(np.mean(V[:k])), alpha_rad=float(np.mean(alpha[:k])))

@@ -135,3 +135,16 @@ def test_decide_weighs_an_unjudged_output_that_gets_worse_against_the_whole_mane
     ok, reason, figures = decide(_cal(1.0, 0.9), fits(1.0, 1.0), fits(0.9, 1.2), ["q"])
     assert not ok and "raise the validation maneuver's r" in reason
     assert figures["validation_cost"]["calibrated"] > figures["validation_cost"]["equation_error"]
+
+
+def test_one_process_gives_the_same_diagnosis(diagnosed, tmp_path):
+    """The second process (validation analysed, replayed and flown meanwhile) changes nothing:
+    with one process the findings, their fits and the calibration are the same numbers."""
+    _, folder = diagnosed["unsteady_alphadot"]
+    rec = json.loads((folder / "findings.json").read_text())["inputs"]
+    diagnose("f16", rec["identification"], tmp_path / "alone", rec["validation"], calibrate_workers=1)
+    one, two = (json.loads((f / "findings.json").read_text()) for f in (tmp_path / "alone", folder))
+    assert json.dumps(one["findings"], sort_keys=True) == json.dumps(two["findings"], sort_keys=True)
+    for key in ("used", "parameters", "fit_after_calibration", "fit_after_equation_error"):
+        assert json.dumps(one["calibration"][key], sort_keys=True) == json.dumps(two["calibration"][key], sort_keys=True)
+    assert two["calibration"]["workers"] == 2 and one["calibration"]["workers"] == 1

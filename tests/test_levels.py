@@ -33,7 +33,7 @@ def _linear_plant(true_offsets: dict[str, float]):
 def test_linear_levels_recovered_exactly():
     fly, measured = _linear_plant({"de": 0.003, "da": -0.002})
     surfaces = {"de": np.zeros(2), "da": np.zeros(2)}
-    sim, offsets, _ = fit_levels(fly, surfaces, {"de": 0.01, "da": 0.01}, measured,
+    sim, offsets = fit_levels(fly, surfaces, {"de": 0.01, "da": 0.01}, measured,
                               {"q": 1e-6, "V": 1e-6, "p": 1e-6}, INNER)
     assert offsets["de"] == pytest.approx(0.003, rel=1e-9)
     assert offsets["da"] == pytest.approx(-0.002, rel=1e-9)
@@ -42,14 +42,14 @@ def test_linear_levels_recovered_exactly():
 
 def test_levels_held_within_their_bound():
     fly, measured = _linear_plant({"de": 0.003})
-    sim, offsets, _ = fit_levels(fly, {"de": np.zeros(2)}, {"de": 0.001}, measured, {"q": 1e-6, "V": 1e-6}, INNER)
+    sim, offsets = fit_levels(fly, {"de": np.zeros(2)}, {"de": 0.001}, measured, {"q": 1e-6, "V": 1e-6}, INNER)
     assert offsets == {"de": pytest.approx(0.001)}
 
 
 def test_no_bound_no_fit_and_unchanged_outputs():
     fly, measured = _linear_plant({"de": 0.003})
     base = fly({"de": np.zeros(2)})
-    sim, offsets, _ = fit_levels(fly, {"de": np.zeros(2)}, {"de": 0.0}, measured, {"q": 1e-6}, INNER)
+    sim, offsets = fit_levels(fly, {"de": np.zeros(2)}, {"de": 0.0}, measured, {"q": 1e-6}, INNER)
     assert offsets == {}
     np.testing.assert_array_equal(sim["q"], base["q"])
 
@@ -62,17 +62,17 @@ def test_a_step_that_diverges_keeps_the_recorded_levels():
             raise FlightError("diverged")
         return fly0(surfaces)
 
-    sim, offsets, _ = fit_levels(fly, {"de": np.zeros(2)}, {"de": 0.01}, measured, {"q": 1e-6}, INNER)
+    sim, offsets = fit_levels(fly, {"de": np.zeros(2)}, {"de": 0.01}, measured, {"q": 1e-6}, INNER)
     assert offsets == {}
 
 
 def test_level_bound_from_noise_and_motion():
-    dt, sigma = 0.02, math.radians(0.05)
+    t, sigma = np.arange(100) * 0.02, math.radians(0.05)
     quiet = np.zeros(100)
-    assert level_bound(quiet, sigma, dt) == pytest.approx(LEVEL_BOUND_SIGMAS * 1.25 * sigma / 5.0)
-    assert level_bound(quiet, 0.0, dt) == 0.0
+    assert level_bound(quiet, sigma, t) == pytest.approx(LEVEL_BOUND_SIGMAS * 1.25 * sigma / 5.0)
+    assert level_bound(quiet, 0.0, t) == 0.0
     moving = np.linspace(0.0, 0.01, 100)
-    assert level_bound(moving, 0.0, dt) == pytest.approx(0.5 * moving[24])
+    assert level_bound(moving, 0.0, t) == pytest.approx(0.5 * moving[24])
 
 
 def test_start_level_is_the_median_of_the_start_window():
@@ -84,20 +84,3 @@ def test_start_level_is_the_median_of_the_start_window():
     assert y[0] == 1.0 and np.array_equal(y[1:], x[1:])
     z = steady_start(np.zeros_like(t), t, level_of=x)  # a smoothed surface, its raw level
     assert z[0] == 1.0
-
-
-def test_another_models_sensitivities_are_reused_with_one_replay():
-    fly0, measured = _linear_plant({"de": 0.003, "da": -0.002})
-    surfaces = {"de": np.zeros(2), "da": np.zeros(2)}
-    floors = {"q": 1e-6, "V": 1e-6, "p": 1e-6}
-    first = fit_levels(fly0, surfaces, {"de": 0.01, "da": 0.01}, measured, floors, INNER)
-    calls = []
-
-    def fly(s):
-        calls.append(1)
-        return fly0(s)
-
-    again = fit_levels(fly, surfaces, {"de": 0.01, "da": 0.01}, measured, floors, INNER, first.sensitivities)
-    assert len(calls) == 1
-    assert again.offsets == pytest.approx(first.offsets, rel=1e-9)
-    np.testing.assert_allclose(again.outputs["p"], measured["p"], atol=1e-12)

@@ -2,6 +2,8 @@
 candidate test, gathered into scored candidates."""
 from __future__ import annotations
 
+import functools
+
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
@@ -12,7 +14,6 @@ from harness.diagnosis import corroborate, rivals
 from harness.diagnosis.gusts import process_noise_model
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
-from models.hidden import SENSOR_EFFECTS
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
 from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_share, corrected_channels,
                                           inertial_angles, is_plausible, is_practical, kinematic_check,
@@ -20,6 +21,7 @@ from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_sh
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, measured_coefficients
 from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
 from models.aircraft import Aircraft, has_propeller
+from models.hidden import SENSOR_EFFECTS
 from models.replay import AeroAlong, InitialCondition, aero_along
 from models.constants import G0_FPS2, SURFACES
 
@@ -616,27 +618,23 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
     terms whose parameter is not in ``skip`` (and its nuisances)."""
     inner = _inner(p)
 
-    vane: list[dict[str, np.ndarray]] = []  # the mismatch along the β vane, made when first asked
+    @functools.cache
+    def along_vane() -> dict[str, np.ndarray]:
+        """The mismatch along the β vane (made when first asked)."""
+        return model_along(p, aircraft, ic, vane_beta=True).mismatch()
 
     def ratios(name: str, value: float, skip: frozenset[str] = frozenset()) -> dict:
         # the inertial sideslip stays the one integrated from p: it is built from the same
         # instruments as the kinematic check, so letting it follow the correction would make
         # the two tests one
-        if _beta_vane_parameter(name) and inertial_beta(p):
+        if kin.parameters[name].channel == "beta" and inertial_beta(p):
             # a β-vane error cannot reach a mismatch along the inertial sideslip: its signature
             # is taken along the vane (whose slow wander the colored-residual fit allows for)
-            if not vane:
-                vane.append(model_along(p, aircraft, ic, vane_beta=True).mismatch())
             changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, vane_beta=True).mismatch()
-            return _axis_ratios(cands, step, inner, vane[0], changed, skip)
+            return _axis_ratios(cands, step, inner, along_vane(), changed, skip)
         changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
         return _axis_ratios(cands, step, inner, mismatch, changed, skip)
     return ratios
-
-
-def _beta_vane_parameter(name: str) -> bool:
-    """A sensor parameter of the β vane (its bias, scale, skew or position)."""
-    return name in ("bias_beta", "scale_beta", "skew_beta", "vane_beta_x")
 
 
 def _axis_ratios(cands: list[Candidate], step: _Stepwise, inner: slice, base: dict[str, np.ndarray],

@@ -27,21 +27,22 @@ from typing import NamedTuple
 import numpy as np
 
 from models.flight import FlightError
-from models.replay import START_WINDOW_S
+from models.replay import START_WINDOW_S, start_samples
 from models.trim import TrimError
 
 LEVEL_STEP_RAD = math.radians(0.02)  # the finite-difference step of a level's sensitivity
 # A level moves at most this many standard errors of the start level (median of the start
-# window: 1.25 σ/√k for white noise), plus half the surface's own motion in that window.
+# window: √(π/2) σ/√k ≈ 1.25 σ/√k for white noise, the median's large-sample efficiency),
+# plus half the surface's own motion in that window.
 LEVEL_BOUND_SIGMAS = 4.0
 
 
-def level_bound(smooth: np.ndarray, noise_std: float, dt: float, window_s: float = START_WINDOW_S) -> float:
+def level_bound(smooth: np.ndarray, noise_std: float, t: np.ndarray, window_s: float = START_WINDOW_S) -> float:
     """How far (rad) a surface's start level may be wrong: :data:`LEVEL_BOUND_SIGMAS` standard
     errors of the median of the first ``window_s`` seconds (1.25 σ/√k, σ the channel's white
     noise, k samples) plus half the smoothed surface's range there (a surface already moving at
     the start). Zero for a noise-free, quiet start: nothing to estimate."""
-    k = max(1, int(math.ceil(window_s / dt)))
+    k = start_samples(t, window_s)
     spread = 0.5 * float(np.ptp(np.asarray(smooth, dtype=float)[:k]))
     return LEVEL_BOUND_SIGMAS * 1.25 * float(noise_std) / math.sqrt(k) + spread
 
@@ -62,13 +63,11 @@ def _stack(sim: Mapping[str, np.ndarray], channels: tuple[str, ...], inner: slic
 
 
 class LevelFit(NamedTuple):
-    """A replay with its surface levels fitted: the outputs by quantity, the offsets (rad) added
-    to each fitted surface, and each surface's sensitivity (output per rad of level, by
-    quantity) for another model of the same maneuver to reuse."""
+    """A replay with its surface levels fitted: the outputs by quantity and the offsets (rad)
+    added to each fitted surface."""
 
     outputs: dict[str, np.ndarray]
     offsets: dict[str, float]
-    sensitivities: dict[str, dict[str, np.ndarray]]
 
 
 def level_sensitivities(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.ndarray]],
@@ -86,8 +85,7 @@ def level_sensitivities(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.n
 
 def fit_levels(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.ndarray]],
                surfaces: Mapping[str, np.ndarray], bounds: Mapping[str, float],
-               measured: Mapping[str, np.ndarray], floors: Mapping[str, float], inner: slice,
-               sensitivities: Mapping[str, Mapping[str, np.ndarray]] | None = None) -> LevelFit:
+               measured: Mapping[str, np.ndarray], floors: Mapping[str, float], inner: slice) -> LevelFit:
     """The replay with each surface's level fitted: one weighted least-squares step on the
     outputs' sensitivities, the outputs then predicted to first order (the offsets are a few
     hundredths of a degree), kept only when it lowers the weighted cost.
@@ -104,32 +102,26 @@ def fit_levels(fly: Callable[[dict[str, np.ndarray]], Mapping[str, np.ndarray]],
     floors : per output, the smallest RMS its weight assumes (its noise level): each output is
         weighted by 1/max(RMS error at the recorded levels, floor).
     inner : the samples compared (the ends of a smoothed record left out).
-    sensitivities : :func:`level_sensitivities` already flown for this model and maneuver (one
-        replay instead of one per surface more); another model's only where it shares the slow
-        dynamics a level excites.
     """
     y0 = {c: np.asarray(v, dtype=float) for c, v in fly(dict(surfaces)).items()}
     channels = tuple(c for c in floors if c in measured and c in y0 and np.all(np.isfinite(y0[c][inner])))
     fitted = [s for s in surfaces if bounds.get(s, 0.0) > 0.0]
     if not channels or not fitted:
-        return LevelFit(y0, {}, {})
+        return LevelFit(y0, {})
     try:
-        sens = dict(sensitivities) if sensitivities is not None else level_sensitivities(fly, surfaces, y0, fitted)
+        sens = level_sensitivities(fly, surfaces, y0, fitted)
     except (FlightError, TrimError):  # a level the step makes diverge: the recorded levels stand
-        return LevelFit(y0, {}, {})
-    fitted = [s for s in fitted if s in sens and all(c in sens[s] for c in channels)]
-    if not fitted:
-        return LevelFit(y0, {}, {})
+        return LevelFit(y0, {})
     z = _stack(measured, channels, inner)
     r0 = z - _stack(y0, channels, inner)
     w = np.concatenate([np.full(len(part), 1.0 / max(float(np.sqrt(np.mean(part ** 2))), floors[c], 1e-12))
                         for c, part in zip(channels, np.split(r0, len(channels)))])
     cols = np.column_stack([_stack(sens[s], channels, inner) for s in fitted])
     if not np.all(np.isfinite(cols)):
-        return LevelFit(y0, {}, sens)
+        return LevelFit(y0, {})
     step, *_ = np.linalg.lstsq(cols * w[:, None], r0 * w, rcond=None)
     off = np.clip(step, [-bounds[s] for s in fitted], [bounds[s] for s in fitted])
     if np.sum(((r0 - cols @ off) * w) ** 2) >= np.sum((r0 * w) ** 2):
-        return LevelFit(y0, {}, sens)
+        return LevelFit(y0, {})
     outputs = {c: y + sum(o * sens[s][c] for s, o in zip(fitted, off) if c in sens[s]) for c, y in y0.items()}
-    return LevelFit(outputs, {s: float(o) for s, o in zip(fitted, off)}, sens)
+    return LevelFit(outputs, {s: float(o) for s, o in zip(fitted, off)})

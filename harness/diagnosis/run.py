@@ -330,7 +330,7 @@ def _fitted_replay(p: Prepared, fly) -> Replayed:
     """``fly`` (surfaces -> history) over ``p``'s surfaces with their levels fitted
     (:func:`levels.fit_levels`); a trim or flight error is reported, not raised."""
     surfaces = _replay_surfaces(p)
-    bounds = {s: levels.level_bound(p.smooth[s], p.noise_std.get(s, 0.0), p.dt) for s in surfaces}
+    bounds = {s: levels.level_bound(p.smooth[s], p.noise_std.get(s, 0.0), p.t) for s in surfaces}
     floors = {c: max(p.noise_std.get(c, 0.0), 1e-9) for c in OUTPUTS if c in p.smooth}
     try:
         fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, _inner(p))
