@@ -176,6 +176,10 @@ def _initialise_in_cruise(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: 
     written = command_configuration(fdm, config)
     fdm["propulsion/set-running"] = -1
     fdm.run_ic()
+    # again after run_ic: it re-initialises some piston engines stopped (JSBSim 1.3: the c310's
+    # and c182's), and a stopped engine leaves trim no equilibrium to find; for an engine
+    # already running the property does nothing
+    fdm["propulsion/set-running"] = -1
     written.update(place_configuration(fdm, config))
     return config, written
 

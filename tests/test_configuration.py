@@ -153,3 +153,19 @@ def test_737_flies_clean():
     assert tp.configuration["positions"]["gear/gear-pos-norm"] == 0.0
     assert fdm["aero/coefficient/CDgear"] == 0.0
     assert tp.configuration["positions"]["fcs/flap-pos-norm"] == 0.0
+
+
+@pytest.mark.parametrize("name, condition", [("c182", "h=4000,V=180"), ("c310", "h=5000,V=200")])
+def test_piston_engines_run_through_the_trim(name, condition):
+    """JSBSim's run_ic leaves the c182's and c310's piston engines stopped even after
+    ``propulsion/set-running``; the trim starts them again after run_ic, and finds level flight
+    with thrust (before: "no level-flight equilibrium" at these cruise conditions)."""
+    path = f"{jsbsim.get_default_root_dir()}/aircraft/{name}/{name}.xml"
+    aircraft = Aircraft(path)
+    fdm = load_fdm(aircraft, 1 / 120)
+    tp = trim(fdm, aircraft, parse_condition(condition))
+    engines = [i for i in range(4) if fdm.get_property_manager().hasNode(f"propulsion/engine[{i}]/thrust-lbs")]
+    assert engines and all(fdm[f"propulsion/engine[{i}]/set-running"] == 1 for i in engines)
+    assert sum(fdm[f"propulsion/engine[{i}]/thrust-lbs"] for i in engines) > 100.0
+    assert tp.method == "jsbsim"
+    assert abs(fdm["accelerations/udot-ft_sec2"]) < 1e-2 and abs(fdm["accelerations/wdot-ft_sec2"]) < 1e-2

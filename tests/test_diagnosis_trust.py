@@ -94,3 +94,58 @@ def test_model_of_another_aircraft_is_refused(tmp_path, shared_dir):
     with pytest.raises(DiagnosisError, match="normal-force coefficient averages"):
         diagnose("f16", _write(heavy, tmp_path / "heavy.csv"), tmp_path / "out3")
     assert not (tmp_path / "out3" / "findings.json").exists()
+
+
+def test_a_state_that_drifts_without_its_input_is_evaluated_along_not_fitted():
+    """prepare.drifted_states: a state whose group's surface never moved is not driven (no
+    term is built on it), but when its excursion from its start (a slow spiral: almost all
+    trend) stands 25 times above the noise the common filter passes, the model is evaluated
+    along it rather than at its start; a Gauss-Markov wander of the vane's size, and the
+    1e-5 rad wiggle of a noise-free record, are not."""
+    import numpy as np
+
+    from harness.diagnosis.prepare import DRIVEN_FLOOR, drifted_states, filtered_noise_std, maneuver_driven
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    rng = np.random.default_rng(5)
+    w = np.ones(n - 2) * 0.1  # the filter passes sigma * 0.1 of white noise
+    sigma = np.radians(0.1)
+    gm = np.zeros(n)
+    for k in range(1, n):  # first-order Gauss-Markov, 0.1 deg, tau 1 s
+        gm[k] = np.exp(-dt) * gm[k - 1] + np.sqrt(1 - np.exp(-2 * dt)) * sigma * rng.standard_normal()
+    smooth = {"da": np.radians(2.0) * (np.abs(t - 3.0) < 1.0), "de": np.zeros(n),
+              "alpha": np.radians(1.4) * t / t[-1],          # a spiral's slow α drift: all trend
+              "q": gm,                                        # wander of a vane's size
+              "theta": 1e-5 * np.sin(2 * np.pi * 0.3 * t),    # noise-free wiggle, below the floor
+              "p": np.radians(5.0) * np.sin(2 * np.pi * 0.5 * t)}
+    noise = {"alpha": sigma, "q": sigma, "theta": 0.0, "p": sigma, "da": 1e-4, "de": 1e-4}
+    driven = maneuver_driven(smooth, noise, w, excited=("da",))
+    assert "alpha" not in driven and "da" in driven and "p" in driven
+    # the drift about its own trend is nothing: only its excursion from the start shows it
+    a = smooth["alpha"]
+    assert np.std(a - np.linspace(a[0], a[-1], n)) < 1e-12
+    assert np.sqrt(np.mean((a - a[0]) ** 2)) > 25 * filtered_noise_std(sigma, w)
+    moved = drifted_states(smooth, noise, w, start_samples=25, driven=driven)
+    assert moved == ("alpha",)
+    assert np.std(smooth["theta"]) < DRIVEN_FLOOR["theta"]
+
+
+def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
+    """run._unsupported_in_the_loop: a used calibration that sizes a named term within 3
+    standard errors of no change withdraws it (status 'unsupported', the validation status
+    kept beside it); a term it sizes clearly, or an unused calibration, withdraws nothing."""
+    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.run import CALIBRATED_MIN_Z, _unsupported_in_the_loop
+
+    def cand(parameter, estimate):
+        return Candidate("cross_coupling", "roll", "Cl", parameter, estimate, 0.29, -5.7, 0.5, "per rad^2",
+                         "stepwise on the Cl mismatch", selected=True, reason="entered")
+
+    weak, strong = cand("Cl_alpha_beta", -1.66), cand("Cn_beta_abs", 0.2)
+    sized = {"Cl_alpha_beta": {"size": -0.0165, "std_error": 0.015}, "Cn_beta_abs": {"size": 0.19, "std_error": 0.01}}
+    checks = {id(weak): {"status": "confirmed", "axes": ["Cl"]}}
+    assert _unsupported_in_the_loop([weak, strong], {"used": False, "findings": sized}, checks) == []
+    assert _unsupported_in_the_loop([weak, strong], {"used": True, "findings": sized}, checks) == [weak]
+    assert checks[id(weak)]["status"] == "unsupported" and checks[id(weak)]["validation_status"] == "confirmed"
+    assert f"within {CALIBRATED_MIN_Z:g} standard errors" in checks[id(weak)]["reason"]
+    assert id(strong) not in checks

@@ -244,3 +244,29 @@ def test_a_beta_vane_scale_is_corroborated_along_the_vane(tmp_path):
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
     assert abs(row["first"]["estimate"] - c.truth) <= 0.25 * c.truth
+
+
+def test_a_spiral_after_a_lateral_input_makes_no_finding_of_its_own(tmp_path):
+    """Outside case D_lateral (DHC-6, 60 ms aileron delay): the aircraft leaves the maneuver
+    in a spiral, V 227 to 320 ft/s and 60 deg of bank. α, q and V move by tens of their noise
+    levels with the stabilator still: the model is evaluated along them, but no term is built
+    on them (held at their start, C_m's mismatch stood at 11 times its noise and a C_m,ΔV
+    "finding" entered at t = 42). The delay is named, nothing else."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "D_lateral_control_delay_tau_da_0.06")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
+
+
+def test_the_twin_otter_self_check_gives_none(tmp_path):
+    """The noise-free DHC-6 self-check (three-axis): equation error draws a C_l,αβ of
+    -1.66 ± 0.29 per rad² from the propeller torque's change with airspeed in the spiral; the
+    calibration in the loop sizes it -0.017 ± 0.015 and it is withdrawn, listed as
+    'unsupported' in not_confirmed."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "selfcheck_dhc6_D")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["first"]["effect"] == "none" and row["c"] == 0, row["findings"]
+    found = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
+    withdrawn = [f for f in found["not_confirmed"] if f["evidence"]["validation"]["status"] == "unsupported"]
+    assert [f["parameter"] for f in withdrawn] == ["Cl_alpha_beta"]

@@ -215,7 +215,9 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None,
 
     A state the maneuver did not drive is held at its start: evaluated along its noise, the
     model would pass that noise on through its derivative (errors in variables), and the
-    mismatch would then show the derivative itself as "wrong". Surfaces are measured with
+    mismatch would then show the derivative itself as "wrong" (unless it drifted far from its
+    start all the same, :attr:`Prepared.moved`: then holding it would be the larger error).
+    Surfaces are measured with
     little noise: always as recorded (holding one that moves, say by a feedback loop, would
     be far worse than its noise). Airspeed and altitude are slow: their own optimal
     smoothing (a far lower cut-off than the common filter's) keeps their noise out of the
@@ -229,7 +231,7 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None,
     scale then leaves the mismatch alone; the kinematic check names it."""
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
     for k in ("alpha", "beta", "p", "q", "r"):
-        if k in states and k not in p.driven:
+        if k in states and k not in p.driven and k not in p.moved:
             states[k] = np.full(p.n, p.start[k])
     if inertial_beta(p) and not vane_beta:
         src = inertial_from or p
@@ -261,7 +263,7 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
     (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
     sideslip with ``vane_beta``)."""
     states, surfaces = model_states(p, inertial_from, vane_beta)
-    alphadot = p.deriv["alpha"] if "alpha" in p.driven else None
+    alphadot = p.deriv["alpha"] if "alpha" in p.driven or "alpha" in p.moved else None
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
     return ModelAlong(states, surfaces, alphadot, aero, measured)

@@ -212,7 +212,7 @@ class Condition:
     """Where a case flies: aircraft, condition by value, loop, input amplitudes (deg)."""
 
     key: str
-    aircraft: str          # 'f16', '737' or 'c172x'
+    aircraft: str          # 'f16', '737', 'dhc6' or 'c172x'
     condition: str         # 'h=...,V=...'
     de_deg: float
     da_deg: float
@@ -241,6 +241,9 @@ CONDITIONS = {c.key: c for c in (
     Condition("C1", "c172x", "h=4000,V=180", 2.0, 5.0, 5.0, note="c172x, 4,000 ft, 180 ft/s, alpha 0.8 deg"),
     Condition("C2", "c172x", "h=8000,V=200", 2.0, 5.0, 5.0, note="c172x, 8,000 ft, 200 ft/s, alpha 0.6 deg"),
     Condition("B", "737", "h=30000,V=750", 1.0, 3.0, 3.0, note="737 cruise, 30,000 ft, 750 ft/s"),
+    Condition("D", "dhc6", "h=6000,V=230", 2.0, 2.0, 2.0,
+              note="DHC-6 Twin Otter (two turboprops), 6,000 ft, 230 ft/s: a lateral input leaves it in a "
+                   "slow spiral, alpha and q drifting by degrees"),
 )}
 
 KINDS = ("pitch", "lateral", "three_axis")
@@ -374,10 +377,31 @@ def cases() -> tuple[OutsideCase, ...]:
     for where, kind, seed in nulls:
         out.append(OutsideCase(f"{where}_{kind}_none_s{seed}", where, kind, seed=seed))
     out = [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
-    for where in ("S", "B", "C1"):
+    out += _twin_otter_cases()
+    for where in ("S", "B", "C1", "D"):
         out.append(OutsideCase(f"selfcheck_{CONDITIONS[where].aircraft}_{where}", where, "three_axis", clean=True,
                                self_check=True))
     return tuple(out)
+
+
+def _twin_otter_cases() -> list[OutsideCase]:
+    """The DHC-6 (a turboprop, its propeller torque trimmed): a third aircraft, whose lateral
+    inputs leave a slow spiral (its own drops, so the F-16 and c172x cases stay as they were)."""
+    spec = [
+        ("pitch", H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q"),
+        ("pitch", H("sensor_bias", 0.5 * DEG, channel="q"), "bias_q", 0.5 * DEG, "q"),
+        ("pitch", H("control_delay", 0.08, surface="de"), "tau_de", 0.08, "q"),
+        ("lateral", H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r"),
+        ("lateral", H("control_delay", 0.06, surface="da"), "tau_da", 0.06, "p"),
+        ("three_axis", H("cg_offset", 0.5), "dx_moment_reference", 0.5, "q"),
+        ("three_axis", H("sensor_bias", 1.0 * DEG, channel="beta"), "bias_beta", 1.0 * DEG, "beta"),
+    ]
+    out = [OutsideCase(f"D_{kind}_{e.effect}_{param}_{truth:g}" if abs(truth) >= 0.01
+                       else f"D_{kind}_{e.effect}_{param}_{truth / DEG:g}deg", "D", kind, (e,), e.effect, param, truth, ch)
+           for kind, e, param, truth, ch in spec]
+    out += [OutsideCase(f"D_{kind}_none_s{seed}", "D", kind, seed=seed)
+            for kind, seed in (("pitch", 15), ("lateral", 16), ("three_axis", 17))]
+    return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -390,7 +414,8 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     cond = c.condition
-    label = {"f16": "F-16", "737": "Boeing 737", "c172x": "Cessna 172 (JSBSim c172x)"}[cond.aircraft]
+    label = {"f16": "F-16", "737": "Boeing 737", "c172x": "Cessna 172 (JSBSim c172x)",
+             "dhc6": "DHC-6 Twin Otter"}[cond.aircraft]
     paths, answers = {}, {}
     for i, (role, inp) in enumerate(zip(("identification", "validation"), maneuvers(c.kind, cond))):
         flown = inp if c.clean else Actuated(inp)

@@ -28,7 +28,7 @@ DRIVEN_BY = {"alpha": ("de",), "q": ("de",), "theta": ("de",), "V": ("de",),
 # common filter lets through (sigma * sqrt(mean(w^2)), Parseval on the sine series).
 DRIVEN_SNR = 5.0
 # A state whose filtered signal stands this far above that noise moved, whatever moved it (a
-# lateral departure swings α by degrees with the stabilator still).
+# lateral departure swings α by degrees with the stabilator still): drifted_states.
 SELF_EVIDENT_SNR = 25.0
 # And it must move by at least this much (std about its trend, canonical units): a noise-free
 # pitch maneuver's lateral states wiggle by 1e-5 rad, far above a noise floor of zero.
@@ -52,8 +52,11 @@ class Prepared:
     excited : the channels whose signal stands clear of their noise.
     driven : the states the maneuver drove (:func:`maneuver_driven`) and the surfaces that
         moved: the only ones a candidate term may be built on, and the only states the model
-        is evaluated along (the others are held at their start values: their noise, passed
-        through the model's derivatives, would look like a wrong derivative).
+        is evaluated along besides ``moved`` (the others are held at their start values: their
+        noise, passed through the model's derivatives, would look like a wrong derivative).
+    moved : the states the maneuver did not drive that drifted far from their start all the
+        same (:func:`drifted_states`): the model is evaluated along them, no term is built on
+        them.
     measured : coefficients (Eqs. 1-5) from the filtered channels.
     start : the recording's initial values (means over the first 0.5 s of ``smooth``).
     meta : the recording's metadata.
@@ -78,6 +81,7 @@ class Prepared:
     own_noise: dict[str, np.ndarray] = field(default_factory=dict)  # raw − each channel's own optimal smoothing
     mass: dict[str, np.ndarray] = field(default_factory=dict)
     driven: tuple[str, ...] = ()
+    moved: tuple[str, ...] = ()
     assumptions: tuple[dict, ...] = ()  # what stood in for missing channels or metadata
     altitude: np.ndarray | None = None  # ft: the h channel (own smoothing), or its stand-in
     recording: Recording | None = None  # the recording itself (for model fits that need its channels)
@@ -166,6 +170,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
         raise ValueError(f"recording {rec.name!r} lacks mass properties Eqs. 1-5 need: {exc}") from exc
     measured = measured_coefficients(smooth, deriv, rec.meta, mass)
     driven = maneuver_driven(smooth, noise, w, excited)
+    moved = drifted_states(smooth, noise, w, k, driven)
     own_noise = {c: np.asarray(f.noise) for c, f in fits.items()}
     if "h" in raw:
         altitude = raw["h"] - own_noise["h"]
@@ -181,7 +186,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     return Prepared(name=name, t=t, dt=dt, raw=raw, smooth=smooth, deriv=deriv, noise_std=noise,
                     cutoff_hz={c: f.cutoff_hz for c, f in fits.items()}, weights=w, common_cutoff_hz=cutoff,
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
-                    own_noise=own_noise, mass=mass, driven=driven, assumptions=tuple(assumptions),
+                    own_noise=own_noise, mass=mass, driven=driven, moved=moved, assumptions=tuple(assumptions),
                     altitude=altitude, recording=rec)
 
 
@@ -224,10 +229,11 @@ def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weig
     A surface counts when it is ``excited`` (its smoothed signal at least 5 times its noise).
     A state counts when a surface of its group moved (:data:`DRIVEN_BY`: the lateral states
     need an aileron or rudder input, the longitudinal ones a stabilator input) *and* its
-    filtered, detrended signal stands ``snr`` times above the white noise the filter passes,
-    or when it stands :data:`SELF_EVIDENT_SNR` times above it whatever moved it.
+    filtered, detrended signal stands ``snr`` times above the white noise the filter passes.
     Coloured sensor noise inside the band can pass the second test; the first is what keeps
-    a pitch maneuver's β, p and r out of the analysis."""
+    a pitch maneuver's β, p and r out of the analysis. A state that moved far without its
+    group's input (a lateral input's spiral, turbulence) is not driven: the model is evaluated
+    along it (:func:`drifted_states`), no term is built on it."""
     def ratio(c: str) -> float:
         x = smooth[c]
         signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
@@ -243,9 +249,38 @@ def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weig
     for state, group in DRIVEN_BY.items():
         if state not in smooth:
             continue
-        r = ratio(state)
-        if (r >= snr and any(g in surfaces for g in group)) or r >= SELF_EVIDENT_SNR:
+        if ratio(state) >= snr and any(g in surfaces for g in group):
             out.append(state)
+    return tuple(out)
+
+
+def drifted_states(smooth: dict[str, np.ndarray], noise: dict[str, float], weights: np.ndarray,
+                   start_samples: int, driven: tuple[str, ...]) -> tuple[str, ...]:
+    """The states not ``driven`` that moved far all the same: their filtered signal, about its
+    trend or about their start level (the RMS of x − x_start, x_start the mean of the first
+    ``start_samples``), stands :data:`SELF_EVIDENT_SNR` times above the white noise the common
+    filter passes.
+
+    The model is evaluated along such a state, but no candidate term is built on it.
+    Evaluated along: held at its start, the model would carry its own derivative times the
+    whole motion into the mismatch. The excursion counts, not only the signal about the trend
+    (what the sine-series filter smooths), because a slow departure is almost all trend: a
+    lateral input leaves the DHC-6 in a spiral, α 1.4° and q 3°/s off their start (ratio
+    about the trend 5 and 15, excursion 35 and 50), and held there C_Z's mismatch stood at 10
+    times its noise. No term: a motion its group's input did not cause is the aircraft's
+    slow departure, along which whatever the model leaves out of the power and Mach effects
+    grows too (a DHC-6 spiral from 230 to 390 ft/s made a C_m,ΔV "finding" at t = 42; on a
+    pitch maneuver its yaw rate drifts 37 times its noise and C_n,r̂ entered at t = 28)."""
+    out = []
+    for c in DRIVEN_BY:
+        if c in driven or c not in smooth:
+            continue
+        x = smooth[c]
+        signal = max(float(np.std(x - np.linspace(x[0], x[-1], x.size))),
+                     float(np.sqrt(np.mean((x - np.mean(x[:start_samples])) ** 2))))
+        if signal >= max(SELF_EVIDENT_SNR * filtered_noise_std(noise.get(c, 0.0), weights),
+                         DRIVEN_FLOOR.get(c, 0.0)):
+            out.append(c)
     return tuple(out)
 
 
@@ -290,4 +325,8 @@ def undriven_reason(p: Prepared, sources: list[str] | tuple[str, ...]) -> str:
             words.append("the airspeed never moved above its noise (no phugoid)")
         else:
             words.append(f"{_SOURCE_WORDS.get(s, s)} never moved above its noise")
+    drifted = [s for s in missing if s in p.moved]
+    if drifted:
+        words.append(f"{', '.join(_SOURCE_WORDS.get(s, s) for s in drifted)} drifted only with the aircraft's "
+                     "departure (the model is evaluated along it; no term is built on it)")
     return "; ".join(dict.fromkeys(words)) or "not excited"
