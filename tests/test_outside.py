@@ -270,3 +270,32 @@ def test_the_twin_otter_self_check_gives_none(tmp_path):
     found = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
     withdrawn = [f for f in found["not_confirmed"] if f["evidence"]["validation"]["status"] == "unsupported"]
     assert [f["parameter"] for f in withdrawn] == ["Cl_alpha_beta"]
+
+
+def test_other_conventions_read_back_as_written(tmp_path):
+    """The outside sweep's conventions: the 'deg-kts' rewrite reads back (through the reader's
+    own unit table) to the canonical values; the multisine and sweep styles drive the kind's
+    surfaces, the validation maneuver stays the multi-step one; Convention names only what
+    departs from the usual recording."""
+    from harness.diagnosis.outside import CONDITIONS, OTHER_UNITS, Convention, maneuvers, rewrite_in_units
+    from harness.recording_io import read_recording, write_recording
+    from maneuvers.fly import FlightSpec, fly_maneuver
+    from models.aircraft import Aircraft
+    rec = fly_maneuver(FlightSpec(aircraft=Aircraft("f16"), condition="h=10000,V=420", duration_s=8.0))
+    keep = [c for c in rec.data.columns if not c.startswith("truth_")]
+    rec = type(rec)(data=rec.data[keep], meta={k: v for k, v in rec.meta.items() if k != "truth"}, name="r")
+    path = write_recording(rec, tmp_path / "r.csv")
+    rewrite_in_units(path, OTHER_UNITS)
+    header = path.read_text().splitlines()[0].split(",")
+    assert {"V_kts", "alpha_deg", "q_dps", "h_m", "ax_g", "qbar_psf"} <= set(header) and "V_fps" not in header
+    back = read_recording(path).data
+    for c in ("V_fps", "alpha_rad", "q_rps", "h_ft", "az_g"):
+        assert np.allclose(back[c].to_numpy(), rec.data[c].to_numpy(), rtol=1e-12, atol=1e-12), c
+    for kind, surfaces in (("pitch", {"de"}), ("lateral", {"da", "dr"}), ("three_axis", {"de", "da", "dr"})):
+        ident, valid = maneuvers(kind, CONDITIONS["S"], "multisine")
+        assert set(ident.surfaces) == surfaces and valid.name.endswith("_validation")
+        assert set(maneuvers(kind, CONDITIONS["S"], "sweep")[0].surfaces) == ({"de"} if kind == "pitch" else {"da"})
+    with pytest.raises(ValueError, match="input style"):
+        maneuvers("pitch", CONDITIONS["S"], "chirp")
+    assert Convention().describe() == ""
+    assert Convention(rate_hz=25.0, units="deg-kts").describe() == "25 Hz, deg-kts"

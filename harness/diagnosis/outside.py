@@ -47,9 +47,12 @@ from harness.diagnosis.sweep import run_resumable, size_right, validation_drop
 from harness.noise import ChannelNoise, NoiseModel, apply_noise
 from harness.noise_presets import WHITE_LEVELS
 from harness.recording_io import write_recording
+from maneuvers.channels import CHANNELS
 from maneuvers.combine import Sequence
 from maneuvers.fly import FlightSpec, fly_maneuver
+from maneuvers.multisine import Multisine
 from maneuvers.multistep import multistep
+from maneuvers.sweeps import FrequencySweep
 from maneuvers.recording import Recording
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence
@@ -157,16 +160,18 @@ def round_significant(x: np.ndarray, digits: int = SIGNIFICANT_DIGITS) -> np.nda
     return np.array([float(fmt(v)) for v in np.asarray(x, dtype=float).tolist()])
 
 
-def flight_test_noise() -> NoiseModel:
-    """White noise at the ``white`` preset's levels on every channel, and on α and β a
-    first-order Gauss-Markov process besides (0.1°, τ = 1 s): vane and air-data errors
-    that wander. No deliberate biases (a sensor bias is a concealed effect of its own)."""
-    channels = {k: ChannelNoise(white_std=v) for k, v in WHITE_LEVELS.items()}
+def flight_test_noise(white_scale: float = 1.0, gauss_markov_deg: float = 0.1) -> NoiseModel:
+    """White noise at the ``white`` preset's levels (times ``white_scale``) on every channel,
+    and on α and β a first-order Gauss-Markov process besides (``gauss_markov_deg``, τ = 1 s):
+    vane and air-data errors that wander. No deliberate biases (a sensor bias is a concealed
+    effect of its own)."""
+    channels = {k: ChannelNoise(white_std=white_scale * v) for k, v in WHITE_LEVELS.items()}
     for k in ("alpha", "beta"):
-        channels[k] = ChannelNoise(white_std=WHITE_LEVELS[k], colored_std=0.1 * DEG, colored_tau_s=1.0)
-    return NoiseModel.build("flight-test", channels, source="sidbench outside sweep: white preset levels, "
-                                                             "Gauss-Markov 0.1 deg (tau 1 s) on alpha and beta",
-                            drop=("pdot", "qdot", "rdot"))
+        channels[k] = ChannelNoise(white_std=white_scale * WHITE_LEVELS[k], colored_std=gauss_markov_deg * DEG,
+                                   colored_tau_s=1.0)
+    return NoiseModel.build("flight-test", channels, source=(
+        f"sidbench outside sweep: white preset levels x {white_scale:g}, Gauss-Markov {gauss_markov_deg:g} deg "
+        "(tau 1 s) on alpha and beta"), drop=("pdot", "qdot", "rdot"))
 
 
 def _team_meta(meta: dict, data: pd.DataFrame, aircraft_label: str, maneuver: str) -> dict:
@@ -183,7 +188,8 @@ def _team_meta(meta: dict, data: pd.DataFrame, aircraft_label: str, maneuver: st
 
 
 def postprocess(rec: Recording, *, noise: bool = True, seed: int = 1, drop: tuple[str, ...] = (),
-                mode: StructuralMode | None = None, aircraft_label: str = "") -> tuple[Recording, dict]:
+                mode: StructuralMode | None = None, aircraft_label: str = "",
+                noise_model: NoiseModel | None = None) -> tuple[Recording, dict]:
     """A flown recording as a flight-test team's data arrive; ``(recording, answer)``.
 
     ``noise=False`` gives the clean self-check recording (Earth-relative rates, no noise, no
@@ -193,7 +199,7 @@ def postprocess(rec: Recording, *, noise: bool = True, seed: int = 1, drop: tupl
         rec = mode.add_to(rec)
     if noise:
         rec = Recording(data=inertial_gyros(rec.data), meta=rec.meta, name=rec.name)
-        rec = apply_noise(rec, flight_test_noise(), seed)
+        rec = apply_noise(rec, noise_model or flight_test_noise(), seed)
     rec, answer = conceal(rec)
     data = rec.data.drop(columns=[c for c in rec.data.columns
                                   if c.split("_")[0] in set(drop) | {"pdot", "qdot", "rdot"}])
@@ -249,8 +255,17 @@ CONDITIONS = {c.key: c for c in (
 KINDS = ("pitch", "lateral", "three_axis")
 
 
-def maneuvers(kind: str, cond: Condition) -> tuple[Sequence, Sequence]:
-    """Identification and (different) validation inputs of a kind at a condition."""
+INPUT_STYLES = ("multistep", "multisine", "sweep")
+
+
+def maneuvers(kind: str, cond: Condition, style: str = "multistep") -> tuple[object, Sequence]:
+    """Identification and (different) validation inputs of a kind at a condition.
+
+    ``style`` is the identification input's: multi-steps (pitch 3-2-1-1; aileron doublet and
+    rudder 2-1-1), an orthogonal multisine on the kind's surfaces at the same peak deflections
+    (15 s, 0.1-1.5 Hz), or a linear frequency sweep (20 s, 0.1-2 Hz, half the peak deflection;
+    the stabilator's, or for a lateral or three-axis kind the aileron's). The validation
+    maneuver is always the multi-step one."""
     a_e, a_a, a_r = cond.de_deg, cond.da_deg, cond.dr_deg
     pitch_id = (multistep("3-2-1-1", "de", a_e, 0.5),)
     pitch_va = (multistep("2-1-1-2", "de", 0.75 * a_e, 0.7),)
@@ -258,8 +273,41 @@ def maneuvers(kind: str, cond: Condition) -> tuple[Sequence, Sequence]:
     lat_va = (multistep("doublet", "dr", a_r, 1.0), multistep("2-1-1", "da", a_a, 0.7))
     ident, valid = {"pitch": (pitch_id, pitch_va), "lateral": (lat_id, lat_va),
                     "three_axis": (pitch_id + lat_id, pitch_va + lat_va)}[kind]
-    return (Sequence(ident, gap_s=2.0, name=f"outside_{kind}_identification"),
-            Sequence(valid, gap_s=2.0, name=f"outside_{kind}_validation"))
+    validation = Sequence(valid, gap_s=2.0, name=f"outside_{kind}_validation")
+    if style == "multistep":
+        return Sequence(ident, gap_s=2.0, name=f"outside_{kind}_identification"), validation
+    surfaces = {"pitch": ("de",), "lateral": ("da", "dr"), "three_axis": ("de", "da", "dr")}[kind]
+    peak = {"de": a_e, "da": a_a, "dr": a_r}
+    if style == "multisine":
+        return (Multisine(surfaces, period_s=15.0, f_min_hz=0.1, f_max_hz=1.5,
+                          amplitude_deg=tuple(peak[x] for x in surfaces), name=f"outside_{kind}_multisine"),
+                validation)
+    if style == "sweep":
+        surface = "de" if kind == "pitch" else "da"
+        return FrequencySweep(surface, 0.1, 2.0, 20.0, 0.5 * peak[surface], name=f"outside_{kind}_sweep"), validation
+    raise ValueError(f"input style {style!r} is not one of {INPUT_STYLES}")
+
+
+@dataclass(frozen=True)
+class Convention:
+    """How a case's recording departs from the sweep's usual one (the defaults: none). The
+    conventions a team's data may legally use that the project's own recordings never do."""
+
+    inputs: str = "multistep"      # INPUT_STYLES: the identification input
+    rate_hz: float = 50.0          # sample rate
+    white_scale: float = 1.0       # white noise, times the white preset's levels
+    gauss_markov_deg: float = 0.1  # the α and β vanes' Gauss-Markov wander
+    actuator_rps: float = 40.0     # the second-order actuators' natural frequency (ζ 0.7)
+    duration_s: float = DURATION_S
+    units: str = "canonical"       # or 'deg-kts': angles in deg, rates in deg/s, V in kts, h in m
+
+    def describe(self) -> str:
+        """The departures from the usual recording, '' for none."""
+        base = Convention()
+        words = {"inputs": lambda v: v, "rate_hz": lambda v: f"{v:g} Hz", "white_scale": lambda v: f"noise x{v:g}",
+                 "gauss_markov_deg": lambda v: f"vane wander {v:g} deg", "actuator_rps": lambda v: f"actuator {v:g} rad/s",
+                 "duration_s": lambda v: f"{v:g} s", "units": lambda v: v}
+        return ", ".join(words[k](getattr(self, k)) for k in words if getattr(self, k) != getattr(base, k))
 
 
 @dataclass(frozen=True)
@@ -280,6 +328,7 @@ class OutsideCase:
     drop: tuple[str, ...] = ()  # quantities the team did not record (h, thrust)
     clean: bool = False         # the noise-free self-check
     self_check: bool = False
+    convention: Convention = Convention()
 
     @property
     def condition(self) -> Condition:
@@ -378,6 +427,7 @@ def cases() -> tuple[OutsideCase, ...]:
         out.append(OutsideCase(f"{where}_{kind}_none_s{seed}", where, kind, seed=seed))
     out = [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
     out += _twin_otter_cases()
+    out += _convention_cases()
     for where in ("S", "B", "C1", "D"):
         out.append(OutsideCase(f"selfcheck_{CONDITIONS[where].aircraft}_{where}", where, "three_axis", clean=True,
                                self_check=True))
@@ -404,6 +454,49 @@ def _twin_otter_cases() -> list[OutsideCase]:
     return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
 
 
+def _convention_cases() -> list[OutsideCase]:
+    """Recordings in conventions the project's own never use (:class:`Convention`): multisine
+    and sweep inputs, 25 and 100 Hz, twice the noise, a wider vane wander, slower actuators,
+    15 and 60 s, other units. Mostly nulls (what goes wrong is the point), and a few effects
+    (their own drops and seeds, so the other cases stay as they were)."""
+    spec = [  # where, kind, convention, effect (None: a null), parameter, truth, channel
+        ("S", "three_axis", Convention(inputs="multisine"), None),
+        ("L", "pitch", Convention(inputs="sweep"), None),
+        ("M", "pitch", Convention(duration_s=15.0), None),
+        ("S", "pitch", Convention(rate_hz=100.0), None),
+        ("S", "pitch", Convention(rate_hz=25.0), None),
+        ("S", "three_axis", Convention(white_scale=2.0), None),
+        ("S", "three_axis", Convention(actuator_rps=20.0), None),
+        ("C1", "three_axis", Convention(inputs="multisine"), None),
+        ("F", "pitch", Convention(duration_s=60.0), None),
+        ("S", "lateral", Convention(units="deg-kts"), None),
+        ("H", "three_axis", Convention(gauss_markov_deg=0.2), None),
+        ("L", "lateral", Convention(inputs="sweep"), None),
+        ("D", "three_axis", Convention(inputs="multisine"), None),
+        ("S", "three_axis", Convention(inputs="multisine"),
+         (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
+        ("L", "lateral", Convention(inputs="sweep"),
+         (H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r")),
+        ("S", "pitch", Convention(rate_hz=100.0), (H("control_delay", 0.06, surface="de"), "tau_de", 0.06, "q")),
+        ("F", "pitch", Convention(rate_hz=25.0), (H("nonlinear_alpha", 1.0), "Cm_alpha2", 1.0, "q")),
+        ("H", "three_axis", Convention(white_scale=2.0),
+         (H("sensor_bias", 0.5 * DEG, channel="q"), "bias_q", 0.5 * DEG, "q")),
+        ("S", "three_axis", Convention(actuator_rps=20.0), (H("cg_offset", 1.0), "dx_moment_reference", 1.0, "q")),
+        ("L", "pitch", Convention(units="deg-kts"), (H("unsteady_alphadot", -3.0), "Cm_alphadot", -3.0, "q")),
+    ]
+    out = []
+    for i, (where, kind, cv, effect) in enumerate(spec):
+        tag = "_".join("".join(ch for ch in part if ch.isalnum() or ch in ".-") for part in cv.describe().split(", "))
+        if effect is None:
+            out.append(OutsideCase(f"{where}_{kind}_none_{tag}", where, kind, seed=40 + i, convention=cv))
+            continue
+        e, param, truth, ch = effect
+        label = f"{truth:g}" if abs(truth) >= 0.01 else f"{truth / DEG:g}deg"
+        out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{label}_{tag}", where, kind, (e,), e.effect,
+                               param, truth, ch, seed=40 + i, convention=cv))
+    return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
+
+
 # ---------------------------------------------------------------------------------------------
 # Making, diagnosing and scoring a case
 
@@ -417,15 +510,19 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
     label = {"f16": "F-16", "737": "Boeing 737", "c172x": "Cessna 172 (JSBSim c172x)",
              "dhc6": "DHC-6 Twin Otter"}[cond.aircraft]
     paths, answers = {}, {}
-    for i, (role, inp) in enumerate(zip(("identification", "validation"), maneuvers(c.kind, cond))):
-        flown = inp if c.clean else Actuated(inp)
+    cv = c.convention
+    noise = flight_test_noise(cv.white_scale, cv.gauss_markov_deg)
+    for i, (role, inp) in enumerate(zip(("identification", "validation"), maneuvers(c.kind, cond, cv.inputs))):
+        flown = inp if c.clean else Actuated(inp, omega_rps=cv.actuator_rps)
         spec = FlightSpec(input=flown, aircraft=Aircraft(cond.model, hidden=c.effects), condition=cond.condition,
-                          duration_s=max(DURATION_S, inp.duration_s), loop=cond.loop)
+                          duration_s=max(cv.duration_s, inp.duration_s), loop=cond.loop, sample_rate_hz=cv.rate_hz)
         if c.turbulence is not None:
             spec = replace(spec, turbulence=c.turbulence, turbulence_seed=100 * c.seed + i)
         rec, answer = postprocess(fly_maneuver(spec), noise=not c.clean, seed=1000 * c.seed + i, drop=c.drop,
-                                  mode=c.mode, aircraft_label=label)
+                                  mode=c.mode, aircraft_label=label, noise_model=noise)
         paths[role] = write_recording(rec, out_dir / f"{c.name}-{role}.csv")
+        if cv.units != "canonical":  # the writer writes canonical units only; the reader takes these
+            rewrite_in_units(paths[role], OTHER_UNITS)
         answers[role] = answer["hidden_effects"]
     write_text_atomic(out_dir / f"{c.name}.answer.json", json.dumps(
         {"case": c.name, "aircraft": cond.aircraft, "condition": cond.condition, "loop": cond.loop.describe(),
@@ -433,8 +530,32 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
          "truth": c.truth if math.isfinite(c.truth) else None, "hidden_effects": answers["identification"],
          "turbulence": None if c.turbulence is None else c.turbulence.describe(),
          "structural_mode": None if c.mode is None else asdict(c.mode), "dropped": list(c.drop),
-         "recording": "clean (self-check)" if c.clean else "flight-test-like"}, indent=1))
+         "recording": "clean (self-check)" if c.clean else "flight-test-like",
+         "convention": asdict(cv)}, indent=1))
     return paths
+
+
+# The 'deg-kts' convention: every quantity that has one in recording-format.md's table in its
+# other accepted unit (angles in deg, rates in deg/s, airspeed in kts, altitude in m).
+OTHER_UNITS = {"rad": "deg", "rps": "dps", "V_fps": "kts", "h_ft": "m"}
+
+
+def rewrite_in_units(path: Path, units: dict[str, str]) -> None:
+    """Rewrite the CSV ``path`` with its canonical columns in other accepted units (``units``
+    maps a canonical unit, or a whole column name, to the unit wanted), by the reader's own
+    factors (:data:`maneuvers.channels.CHANNELS`), so reading it back gives the canonical
+    values; the file is replaced whole (temporary file, then rename)."""
+    data = pd.read_csv(path)
+    cols = {}
+    for name in data.columns:
+        quantity, _, unit = name.partition("_")
+        want = units.get(name) or units.get(unit)
+        spec = CHANNELS.get(quantity)
+        if want and spec is not None and want in spec.units:
+            cols[f"{quantity}_{want}"] = data[name].to_numpy() / spec.units[want]
+        else:
+            cols[name] = data[name].to_numpy()
+    write_text_atomic(path, pd.DataFrame(cols).to_csv(index=False))
 
 
 # Names the diagnosis gives the same parameter: the accelerometer's x position from the
@@ -454,6 +575,7 @@ def score(c: OutsideCase, result: dict) -> dict:
     row = {"case": c.name, "aircraft": c.condition.aircraft, "where": c.where, "condition": c.condition.condition,
            "kind": c.kind, "expect": c.expect, "parameter": c.parameter,
            "truth": c.truth if math.isfinite(c.truth) else None, "dropped": list(c.drop), "self_check": c.self_check,
+           "convention": c.convention.describe(),
            "first": {k: first.get(k) for k in ("effect", "parameter", "estimate", "std_error")},
            "findings": [{k: f.get(k) for k in ("effect", "parameter", "estimate", "std_error")} for f in findings]}
     if c.expect == "none":
@@ -489,7 +611,8 @@ def run_case(c: OutsideCase, out: Path) -> dict:
         row = {"case": c.name, "aircraft": c.condition.aircraft, "where": c.where, "condition": c.condition.condition,
                "kind": c.kind, "expect": c.expect, "parameter": c.parameter,
                "truth": c.truth if math.isfinite(c.truth) else None, "dropped": list(c.drop),
-               "self_check": c.self_check, "first": None, "findings": [], "a": False,
+               "convention": c.convention.describe(), "self_check": c.self_check, "first": None, "findings": [],
+               "a": False,
                "b": False if c.expect != "none" and math.isfinite(c.truth) else None, "c": 0, "false": [],
                "d": False if c.channel else None, "timing_s": None,
                "error": f"{type(exc).__name__}: {exc}".splitlines()[0][:300],
@@ -516,7 +639,8 @@ def totals(rows: list[dict]) -> dict:
 
 def groups(rows: list[dict]) -> dict[str, dict[str, dict]]:
     by = {"aircraft": lambda r: r["aircraft"], "condition": lambda r: f"{r['aircraft']} {r['condition']}",
-          "kind": lambda r: r["kind"], "truth": lambda r: "null" if r["expect"] == "none" else "effect"}
+          "kind": lambda r: r["kind"], "truth": lambda r: "null" if r["expect"] == "none" else "effect",
+          "recording": lambda r: "other conventions" if r.get("convention") else "usual"}
     out = {}
     for name, key in by.items():
         keys = list(dict.fromkeys(key(r) for r in rows))
@@ -543,7 +667,8 @@ def markdown(rows: list[dict]) -> str:
         truth = "–" if r["truth"] is None else f"{r['truth']:.4g}"
         first = f"error: {r['error']}" if r.get("error") else _finding(r["first"])
         false = str(r["c"]) + (f" ({', '.join(r['false'])})" if r["false"] else "")
-        where = f"{r['aircraft']} {r['condition']}" + (f", no {'/'.join(r['dropped'])}" if r["dropped"] else "")
+        where = (f"{r['aircraft']} {r['condition']}" + (f", no {'/'.join(r['dropped'])}" if r["dropped"] else "")
+                 + (f", {r['convention']}" if r.get("convention") else ""))
         lines.append(f"| {r['case']} | {where} | {truth} | {first} | {mark[r['a']]} | {mark[r['b']]} | {false} | "
                      f"{mark[r['d']]} | {drop} |")
     t = totals(rows)
