@@ -149,3 +149,18 @@ def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
     assert checks[id(weak)]["status"] == "unsupported" and checks[id(weak)]["validation_status"] == "confirmed"
     assert f"within {CALIBRATED_MIN_Z:g} standard errors" in checks[id(weak)]["reason"]
     assert id(strong) not in checks
+
+
+def test_the_model_mass_assumption_names_how_far_the_recording_is():
+    """run._mass_difference: the recording's mass and inertias against the model's, named
+    when 2 % or more apart (the coefficients use the recording's, the replays the model's)."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.run import _mass_difference
+    trim = SimpleNamespace(mass_slug=600.0, Ix_slugft2=9000.0, Iy_slugft2=55000.0, Iz_slugft2=63000.0)
+    same = {"mass_slug": np.full(3, 600.0), "Ix_slugft2": np.full(3, 9050.0), "Iy_slugft2": 55000.0}
+    assert _mass_difference(same, trim) == ""
+    lighter = {"mass_slug": np.full(3, 510.0), "Iy_slugft2": np.full(3, 60500.0)}
+    assert _mass_difference(lighter, trim) == ", the recording's mass 15 % below it, Iy 10 % above it"

@@ -668,8 +668,9 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
             x["stood_in_by"] += f": {a.aero.trim.thrust_lbf:.0f} lbf"
     out.append({"item": "model mass", "missing": "-",
                 "stood_in_by": ("the recording's mass and inertia (first sample)" if mass == "recording" else
-                                f"the model's own mass and inertia ({aircraft.name}); --mass recording flies it "
-                                "with the recording's")})
+                                f"the model's own mass and inertia ({aircraft.name}"
+                                + _mass_difference(a.prepared.mass, a.aero.trim)
+                                + "); --mass recording flies it with the recording's")})
     trim = a.aero.trim
     if trim.held:
         for surface, info in trim.held.items():
@@ -679,6 +680,26 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
                                 "within the noise of its first 0.5 s (fit_before/fit_after: surface_levels_deg; "
                                 "harness/diagnosis/levels.py)")})
     return out
+
+
+# A recording's mass or inertia this far from the model's is named in the model-mass assumption.
+MASS_NOTE_FRACTION = 0.02
+
+
+def _mass_difference(recorded: dict, trim) -> str:
+    """', the recording's mass 15 % below it, Iy 10 % below' for the ones that differ from the
+    model's by :data:`MASS_NOTE_FRACTION` or more at the recording's start ('' when none does):
+    the coefficients are measured with the recording's, the replays fly the model's."""
+    words = []
+    for key, label in (("mass_slug", "mass"), ("Ix_slugft2", "Ix"), ("Iy_slugft2", "Iy"), ("Iz_slugft2", "Iz")):
+        model = float(getattr(trim, key))
+        got = recorded.get(key)
+        if got is None or model <= 0:
+            continue
+        rel = float(np.asarray(got, dtype=float).ravel()[0]) / model - 1.0
+        if abs(rel) >= MASS_NOTE_FRACTION:
+            words.append(f"{label} {100 * abs(rel):.0f} % {'above' if rel > 0 else 'below'} it")
+    return (", the recording's " + ", ".join(words)) if words else ""
 
 
 def _with_recorded_mass(aircraft: Aircraft, rec) -> Aircraft:
