@@ -164,3 +164,26 @@ def test_the_model_mass_assumption_names_how_far_the_recording_is():
     assert _mass_difference(same, trim) == ""
     lighter = {"mass_slug": np.full(3, 510.0), "Iy_slugft2": np.full(3, 60500.0)}
     assert _mass_difference(lighter, trim) == ", the recording's mass 15 % below it, Iy 10 % above it"
+
+
+def test_gusts_too_light_to_name_void_the_sensor_tests_on_a_slow_aircraft():
+    """analysis.light_gusts: the same 1.9 ft/s gust is 0.6 deg at 180 ft/s (six times a
+    0.1 deg vane's noise: the sensor tests are off, and the reason says why) and 0.15 deg at
+    700 ft/s (1.5 times: they stand); a kinematic residual at the noise's level, or a
+    noise-free recording's 0.04 ft/s, is no gust."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.analysis import GUST_ANGLE_FACTOR, GUST_RATIO, light_gusts
+    vane = np.radians(0.1)
+    p = SimpleNamespace(noise_std={"alpha": vane, "beta": vane})
+    gust = SimpleNamespace(sigma_w_fps=1.9, sigma_v_fps=1.2, ratio_to_noise=12.9)
+    why = light_gusts(gust, p, 180.0)
+    assert why.startswith("gusts of about 1.9 ft/s (0.60 deg") and "6.0 times the vanes' noise" in why
+    assert light_gusts(gust, p, 700.0) == ""
+    assert GUST_ANGLE_FACTOR * vane * 180.0 < 1.9 < GUST_ANGLE_FACTOR * vane * 700.0
+    quiet = SimpleNamespace(sigma_w_fps=1.9, sigma_v_fps=1.2, ratio_to_noise=GUST_RATIO - 0.1)
+    assert light_gusts(quiet, p, 180.0) == ""
+    clean = SimpleNamespace(noise_std={"alpha": 0.0, "beta": 0.0})
+    assert light_gusts(SimpleNamespace(sigma_w_fps=0.04, sigma_v_fps=0.0, ratio_to_noise=15.0), clean, 420.0) == ""

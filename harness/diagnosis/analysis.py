@@ -67,6 +67,7 @@ class Analysis:
     peak: object
     not_offered: dict = field(default_factory=dict)  # per axis: candidate parameters the maneuver did not excite
     applied: dict = field(default_factory=dict)      # sensor corrections applied before the model was evaluated
+    gusty: str = ""  # why light gusts leave the kinematic (sensor) tests untrustworthy ('' when they do not)
 
 
 def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
@@ -86,13 +87,15 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # 0. turbulence first: gusts make air-relative and inertial velocities differ, which
     # breaks the kinematic consistency the sensor tests rest on
     gust, turbulent = _turbulence(p)
+    V0 = float(np.mean(p.smooth["V"]))
+    gusty = "" if turbulent else light_gusts(gust, p, V0)
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)
-    V0 = float(np.mean(p.smooth["V"]))
     plausible = _kinematics_plausible(kin, V0)
     contested = _contested(kin)
-    sensor_values = {n: v for n, v in _sensor_values(kin, turbulent, plausible).items() if n not in contested}
-    cands = _kinematic_candidates(kin, p, turbulent, plausible)
+    sensor_values = {n: v for n, v in _sensor_values(kin, turbulent or bool(gusty), plausible).items()
+                     if n not in contested}
+    cands = _kinematic_candidates(kin, p, turbulent, plausible, gusty)
     recorded, p = p, _corrected(p, kin, sensor_values)
     # 2. the model along the measured states
     along = model_along(p, aircraft, ic)
@@ -115,11 +118,13 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     if turbulent:
         _withhold_in_turbulence(cands)
     else:
+        if gusty:
+            _withhold_in_light_gusts(cands, gusty)
         signature = _signature_ratios(cands, kin, p, aircraft, ic, mismatch, step)
-        if plausible:
+        if plausible and not gusty:
             _kinematic_rivals(cands, kin, p, signature, contested)
         _withhold_vane_scale(cands, kin, step, signature, inertial_beta(p))
-        if plausible:
+        if plausible and not gusty:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
@@ -130,7 +135,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         next(c for c in cands if c.effect == "turbulence").details["process_noise_model"] = process_noise_model(p)
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
                     selections=step.selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
-                    not_offered=step.not_offered, applied=dict(sensor_values))
+                    not_offered=step.not_offered, applied=dict(sensor_values), gusty=gusty)
 
 
 def _turbulence(p: Prepared):
@@ -140,6 +145,37 @@ def _turbulence(p: Prepared):
                          0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * G0_FPS2)
     turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
     return gust, turbulent
+
+
+def light_gusts(gust, p: Prepared, V0: float, factor: float | None = None) -> str:
+    """Why gusts too light to name as turbulence still leave the kinematic consistency the
+    sensor tests rest on untrustworthy ('' when they do not): the kinematic residual stands
+    :data:`GUST_RATIO` times above what sensor noise gives, and the gust angle it implies,
+    σ/V, is at least ``factor`` (default :data:`GUST_ANGLE_FACTOR`) times the white noise of
+    the α and β vanes. The same gust is a larger angle the slower the aircraft: 1.9 ft/s at
+    180 ft/s is 0.6 deg, six times a 0.1 deg vane's noise, and there (Dryden severity 2) the
+    kinematics named an α-vane skew and position on a c172x null, and an accelerometer 15 ft
+    aft on a DHC-6 null (outside sweep probes, 2 Dec 2026)."""
+    factor = GUST_ANGLE_FACTOR if factor is None else factor
+    sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
+    vane = max(float(np.mean([p.noise_std.get(c, 0.0) for c in ("alpha", "beta")])), VANE_NOISE_FLOOR_RAD)
+    angle = sigma / max(V0, 1e-9)
+    if gust.ratio_to_noise < GUST_RATIO or angle < factor * vane:
+        return ""
+    return (f"gusts of about {sigma:.1f} ft/s ({np.degrees(angle):.2f} deg of angle at {V0:.0f} ft/s, "
+            f"{angle / vane:.1f} times the vanes' noise; too light to name as turbulence) break the kinematic "
+            "consistency the sensor tests rest on")
+
+
+def _withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:
+    """In gusts too light to name (:func:`light_gusts`) the coefficient terms stand (a C_m,q̂
+    change is still named at Dryden severity 2), but not the accelerometer position fitted to
+    the force mismatch: the gust's pitching part follows q̇ there (a DHC-6 null named an
+    accelerometer 15 ft aft, t = 25)."""
+    for c in cands:
+        if c.selected and c.parameter == "x_accelerometer":
+            c.selected = False
+            c.reason = f"not named: {why}"
 
 
 def _kinematics_plausible(kin: KinematicResult, V0: float) -> bool:
@@ -162,20 +198,22 @@ def _sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool) -> di
 
 
 def _sensor_verdict(name: str, est: float, se: float, entered: bool, kin: KinematicResult, p: Prepared,
-                    turbulent: bool, plausible: bool) -> tuple[bool, str]:
+                    turbulent: bool, plausible: bool, gusty: str = "") -> tuple[bool, str]:
     """Whether a kinematic estimate is named, and why (or why not): it must have entered,
     matter (practical size and share of its channel's excursion), be precise, and the
-    kinematics must hold (no turbulence, plausible estimates)."""
+    kinematics must hold (no turbulence, no gusts that break them, plausible estimates)."""
     practical = is_practical(name, est, p.dt) and _kin_share(kin, name, est, p) >= cand.PRACTICAL_SHARE
     precise = se <= max(0.5 * _practical_size(name, p.dt), 0.25 * abs(est))
-    sel = entered and practical and precise and not turbulent and plausible
+    sel = entered and practical and precise and not turbulent and not gusty and plausible
     reason = ("significant, practical and precise" if sel else "below the entry t" if not entered else
               "within the instrument noise budget (practical size)" if not practical else
-              "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else IMPLAUSIBLE)
+              "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else
+              f"not applied: {gusty}" if gusty else IMPLAUSIBLE)
     return sel, reason
 
 
-def _kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool) -> list[Candidate]:
+def _kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool,
+                          gusty: str = "") -> list[Candidate]:
     """The sensor candidates. The forced (nuisance) biases are tested one by one, not picked
     as the best of many: the aerodynamic entry t serves, with the practical-size and
     precision rules; the selected terms by the kinematic selection's own entry."""
@@ -184,13 +222,13 @@ def _kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, pl
         sp = kin.parameters[name]
         est, se = kin.selection.params[name], kin.selection.std_errors[name]
         t = est / se if se > 0 else 0.0
-        sel, reason = _sensor_verdict(name, est, se, abs(t) >= cand.T_IN, kin, p, turbulent, plausible)
+        sel, reason = _sensor_verdict(name, est, se, abs(t) >= cand.T_IN, kin, p, turbulent, plausible, gusty)
         out.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
                              "kinematic consistency (bias always fitted)", sel, reason))
     for term in kin.selection.terms:
         sp = kin.parameters[term.name]
         sel, reason = _sensor_verdict(term.name, term.estimate, term.std_error, term.selected, kin, p, turbulent,
-                                      plausible)
+                                      plausible, gusty)
         out.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
                              sp.units, "kinematic consistency", sel, reason))
     return out
@@ -903,6 +941,14 @@ NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in 
                    "thrust's own change with airspeed (its force, and its moment about the c.g.)")
 GUST_RATIO = 4.0     # the integrated kinematic residual over what sensor noise alone gives
 GUST_MIN_FPS = 3.0   # and at least light turbulence's RMS gust
+# Gusts below GUST_MIN_FPS still void the sensor tests when their angle σ/V is this many times
+# the vanes' white noise (light_gusts): at Dryden severity 2 the c172x (180 ft/s) and DHC-6
+# (230 ft/s) nulls reached 6 and 4 and made sensor findings; no recording without gusts on
+# either sweep reaches 1.3, nor 1.6 with the vanes' wander doubled (0.2 deg).
+GUST_ANGLE_FACTOR = 2.5
+# The vanes' noise counted is at least this (rad): a noise-free recording's gust estimate
+# (0.04 ft/s on the F-16 self-check) is not a gust.
+VANE_NOISE_FLOOR_RAD = np.radians(0.02)
 NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"
 
 

@@ -428,6 +428,7 @@ def cases() -> tuple[OutsideCase, ...]:
     out = [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
     out += _twin_otter_cases()
     out += _convention_cases()
+    out += _light_gust_cases()
     for where in ("S", "B", "C1", "D"):
         out.append(OutsideCase(f"selfcheck_{CONDITIONS[where].aircraft}_{where}", where, "three_axis", clean=True,
                                self_check=True))
@@ -494,6 +495,27 @@ def _convention_cases() -> list[OutsideCase]:
         label = f"{truth:g}" if abs(truth) >= 0.01 else f"{truth / DEG:g}deg"
         out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{label}_{tag}", where, kind, (e,), e.effect,
                                param, truth, ch, seed=40 + i, convention=cv))
+    return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
+
+
+def _light_gust_cases() -> list[OutsideCase]:
+    """Turbulence too light to name (Dryden severity 1-2: σ 0.9-1.9 ft/s, under the 3 ft/s a
+    turbulence finding needs), on the slow aircraft too, where the same gust is a larger
+    angle: the diagnosis must not take the gusts for sensor errors; and a coefficient error
+    flown through such gusts. Scored as turbulence cases (not naming it is a miss)."""
+    spec = [("S", "three_axis", 1, None), ("L", "pitch", 2, None), ("C1", "three_axis", 2, None),
+            ("H", "lateral", 1, None), ("M", "three_axis", 2, None), ("D", "pitch", 2, None),
+            ("S", "pitch", 2, (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q"))]
+    out = []
+    for i, (where, kind, sev, effect) in enumerate(spec):
+        gusts = Turbulence("dryden", sev, 30.0)
+        if effect is None:
+            out.append(OutsideCase(f"{where}_{kind}_light_turbulence_sev{sev}", where, kind, (), "turbulence",
+                                   "sigma_gust_fps", float("nan"), "", seed=70 + i, turbulence=gusts))
+            continue
+        e, param, truth, ch = effect
+        out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{truth:g}_light_turbulence_sev{sev}", where, kind,
+                               (e,), e.effect, param, truth, ch, seed=70 + i, turbulence=gusts))
     return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
 
 

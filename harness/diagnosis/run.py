@@ -651,6 +651,9 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
         effect = {"scale": "sensor_scale", "skew": "sensor_time_skew"}.get(kind, "sensor_" + kind)
         grouped.setdefault((effect, why), []).append(name)
     out = [{"effect": e, "parameters": sorted(dict.fromkeys(ps)), "reason": why} for (e, why), ps in grouped.items()]
+    if a.gusty:
+        out += [{"effect": e, "parameters": [], "reason": a.gusty}
+                for e in ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")]
     out.append({"effect": "structural_mode", "parameters": [],
                 "reason": f"only modes below {0.5 / p.dt:g} Hz (half the sample rate) can be seen"})
     if not validation_given:
