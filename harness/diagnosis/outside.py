@@ -429,6 +429,7 @@ def cases() -> tuple[OutsideCase, ...]:
     out += _twin_otter_cases()
     out += _convention_cases()
     out += _light_gust_cases()
+    out += _airliner_cases()
     for where in ("S", "B", "C1", "D"):
         out.append(OutsideCase(f"selfcheck_{CONDITIONS[where].aircraft}_{where}", where, "three_axis", clean=True,
                                self_check=True))
@@ -495,6 +496,24 @@ def _convention_cases() -> list[OutsideCase]:
         label = f"{truth:g}" if abs(truth) >= 0.01 else f"{truth / DEG:g}deg"
         out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{label}_{tag}", where, kind, (e,), e.effect,
                                param, truth, ch, seed=40 + i, convention=cv))
+    return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
+
+
+def _airliner_cases() -> list[OutsideCase]:
+    """The 737 at its cruise (30,000 ft, 750 ft/s: the highest dynamic pressure per unit of
+    input of the sweep), beside its self-check: a few effects and a null of each kind (their
+    own drops and seeds, so the other cases stay as they were)."""
+    spec = [("pitch", H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q"),
+            ("lateral", H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r"),
+            ("three_axis", H("control_delay", 0.08, surface="de"), "tau_de", 0.08, "q"),
+            ("pitch", H("sensor_bias", 0.5 * DEG, channel="q"), "bias_q", 0.5 * DEG, "q")]
+    out = []
+    for i, (kind, e, param, truth, ch) in enumerate(spec):
+        label = f"{truth:g}" if abs(truth) >= 0.01 else f"{truth / DEG:g}deg"
+        out.append(OutsideCase(f"B_{kind}_{e.effect}_{param}_{label}", "B", kind, (e,), e.effect, param, truth, ch,
+                               seed=90 + i))
+    out += [OutsideCase(f"B_{kind}_none_s{95 + i}", "B", kind, seed=95 + i)
+            for i, kind in enumerate(("pitch", "lateral", "three_axis"))]
     return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
 
 
