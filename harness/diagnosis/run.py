@@ -200,9 +200,7 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     inner = _inner(av.prepared)
     before_rms = {c: _rms(av.mismatch[c][inner]) for c in axes}
     after_rms = {c: _rms(after[c][inner]) for c in axes}
-    # each axis in units of its own noise level: summed raw, C_Y's mismatch (a_y noise) would
-    # outweigh a C_l or C_n change ten times smaller in coefficient units but larger in noise
-    w = {c: 1.0 / max(av.noise.get(c, 1.0), 1e-300) for c in axes}
+    w = _noise_weights(av, axes)
     ratio = sum(w[c] * after_rms[c] for c in axes) / max(sum(w[c] * before_rms[c] for c in axes), 1e-300)
     status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
     out = {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms, "change": ratio - 1.0}
@@ -213,7 +211,7 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
             out["status"] = "ambiguous"
             out["reason"] = (f"the validation maneuver is fitted about as well by {rival['parameter']} (its rival in "
                              f"the identification fit: columns correlated {rival['correlation']:+.2f}; RMS "
-                             f"{sum(rival['rms_after'].values()):.3g} against {sum(after_rms.values()):.3g}"
+                             f"{rival['noise_levels_rival']:.3g} against {rival['noise_levels_own']:.3g} noise levels"
                              + (f", a difference under {100 * rival['margin']:.0f} %, two standard errors of an RMS "
                                 f"of this record" if rival["margin"] else "") + ")")
         elif rival["indistinct"]:
@@ -253,11 +251,22 @@ def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, n
     rival_after, _ = _after_mismatch(av, [twin])
     inner = _inner(av.prepared)
     rival_rms = {c: _rms(rival_after[c][inner]) for c in axes}
-    own = sum(_rms(after[c]) for c in axes)
+    # summed over the axes in units of each axis's noise level, as validation_check does
+    w = _noise_weights(av, axes)
+    own = sum(w[c] * _rms(after[c]) for c in axes)
+    theirs = sum(w[c] * rival_rms[c] for c in axes)
     # the margin only where the identification maneuver could not tell the two apart
     margin = max(rms_margin(after[c]) for c in axes) if r.get("indistinct") else 0.0
     return {"parameter": r["parameter"], "correlation": r["correlation"], "rms_after": rival_rms, "margin": margin,
-            "fits_as_well": sum(rival_rms.values()) <= own * (1.0 + margin), "indistinct": r.get("indistinct", "")}
+            "noise_levels_own": own, "noise_levels_rival": theirs,
+            "fits_as_well": theirs <= own * (1.0 + margin), "indistinct": r.get("indistinct", "")}
+
+
+def _noise_weights(av: Analysis, axes: list[str]) -> dict[str, float]:
+    """Each axis in units of its own noise level: summed raw, C_Y's mismatch (a_y noise)
+    would outweigh a C_l or C_n change ten times smaller in coefficient units but larger in
+    noise."""
+    return {c: 1.0 / max(av.noise.get(c, 1.0), 1e-300) for c in axes}
 
 
 # The |t| the same sensor parameter must reach, with the same sign, on the validation
