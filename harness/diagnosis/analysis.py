@@ -946,9 +946,12 @@ GUST_MIN_FPS = 3.0   # and at least light turbulence's RMS gust
 # (230 ft/s) nulls reached 6 and 4 and made sensor findings; no recording without gusts on
 # either sweep reaches 1.3, nor 1.6 with the vanes' wander doubled (0.2 deg).
 GUST_ANGLE_FACTOR = 2.5
-# The vanes' noise counted is at least this (rad): a noise-free recording's gust estimate
-# (0.04 ft/s on the F-16 self-check) is not a gust.
-VANE_NOISE_FLOOR_RAD = np.radians(0.02)
+# The vanes' noise counted is at least this (rad), a typical vane's (the white preset's 0.1°),
+# so that no gust angle under 0.25° voids the sensor tests: a recorder's own filtering can
+# leave a real record's vanes a fraction of that noise (the Twin Otter's), and there the 0.4
+# ft/s (0.09°) "gust" is the kinematics' other inconsistencies (its 0.11 g a_y offset), not
+# air; a noise-free recording's 0.04 ft/s is no gust either.
+VANE_NOISE_FLOOR_RAD = np.radians(0.1)
 NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"
 
 
