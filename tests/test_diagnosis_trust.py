@@ -187,3 +187,34 @@ def test_gusts_too_light_to_name_void_the_sensor_tests_on_a_slow_aircraft():
     assert light_gusts(quiet, p, 180.0) == ""
     clean = SimpleNamespace(noise_std={"alpha": 0.0, "beta": 0.0})
     assert light_gusts(SimpleNamespace(sigma_w_fps=0.04, sigma_v_fps=0.0, ratio_to_noise=15.0), clean, 420.0) == ""
+
+
+def test_an_alpha_beta_term_needs_alpha_and_beta_to_move_together():
+    """candidates.joint_excitation: α then β, one after the other (a sequential three-axis
+    maneuver), leaves their product nothing beyond what α and β carry themselves, and the
+    α·β terms are not offered, with the reason; α and β moving at once (at two frequencies)
+    offers them."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.candidates import JOINT_SNR, Term, joint_excitation, offered
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    deg = np.pi / 180
+
+    def recording(alpha, beta):
+        smooth = {"alpha": 0.05 + alpha, "beta": beta, "p": np.zeros(n), "q": np.zeros(n), "r": np.zeros(n),
+                  "V": np.full(n, 420.0), "de": np.zeros(n), "da": np.zeros(n), "dr": np.zeros(n)}
+        return SimpleNamespace(smooth=smooth, start={k: float(v[0]) for k, v in smooth.items()}, dt=dt, n=n,
+                               meta={"geometry": {"S_ft2": 300.0, "b_ft": 30.0, "cbar_ft": 11.32}},
+                               noise_std={"alpha": 0.1 * deg, "beta": 0.1 * deg}, weights=np.full(n - 2, 0.3),
+                               driven=("alpha", "beta", "de", "da"))
+    pulse = lambda t0: 2 * deg * ((t >= t0) & (t < t0 + 2)) * np.sin(np.pi * (t - t0) / 2)  # noqa: E731
+    apart = recording(pulse(3.0), pulse(12.0))
+    together = recording(2 * deg * np.sin(2 * np.pi * 0.3 * t), 2 * deg * np.sin(2 * np.pi * 0.5 * t))
+    assert joint_excitation(apart) < 1.0 < JOINT_SNR < joint_excitation(together)
+    term = Term("alpha_beta", "cross_coupling", "Cl_alpha_beta", "per rad^2", np.zeros(n), sources=("alpha", "beta"))
+    keep, skipped = offered(apart, [term])
+    assert keep == [] and skipped[0].details["not_offered"].startswith("α and β never moved together")
+    assert offered(together, [term])[0] == [term]

@@ -378,6 +378,7 @@ def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str,
     for axis in COEFFICIENTS:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
+                             | ({"reason": t.details["not_offered"]} if "not_offered" in t.details else {})
                              for t in skipped]
         nuisance = _thrust_nuisance(p, axis, terms)
         why = NO_THRUST_DRIFT if "thrust_dV" in nuisance else PROPELLER_DRIFT if (axis in cand.LAT and propeller) \

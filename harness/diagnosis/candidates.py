@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
-from harness.diagnosis.prepare import Prepared
+from harness.diagnosis.prepare import Prepared, filtered_noise_std
 from models.constants import SURFACES
 
 T_IN = 5.0
@@ -130,10 +130,54 @@ REGRESSOR_SOURCE = {"alpha": "alpha", "qhat": "q", "de": "de", "beta": "beta", "
 def offered(p: Prepared, terms: list[Term]) -> tuple[list[Term], list[Term]]:
     """The terms whose every source the maneuver drove (:attr:`Prepared.driven`), and the
     others: a column built on a state the maneuver did not move is that state's noise, and
-    its coefficient would only measure how the model's derivative passes the noise on."""
+    its coefficient would only measure how the model's derivative passes the noise on. A
+    product of two driven states is offered only when they also moved together
+    (:func:`joint_excitation`); otherwise it is skipped with ``details['not_offered']``."""
     driven = set(p.driven)
-    keep = [t for t in terms if set(t.sources) <= driven]
-    return keep, [t for t in terms if not set(t.sources) <= driven]
+    keep, skipped = [], []
+    for t in terms:
+        if not set(t.sources) <= driven:
+            skipped.append(t)
+        elif t.key == "alpha_beta" and (why := _not_together(p)):
+            skipped.append(Term(t.key, t.effect, t.parameter, t.units, t.column, t.scale,
+                                {**t.details, "not_offered": why}, t.sources))
+        else:
+            keep.append(t)
+    return keep, skipped
+
+
+# The product (α − α₀)(β − β₀), less what α and β themselves carry, must stand this many times
+# above the noise it picks up from them to be offered (the driven-state rule's 5).
+JOINT_SNR = 5.0
+
+
+def joint_excitation(p: Prepared) -> float:
+    """How far α and β moved *together*: the RMS of (α − α₀)(β − β₀) once its least-squares
+    fit on 1, α and β is removed (what a coupling term adds beyond the model's own
+    derivatives), over the noise the product picks up from its factors,
+    √((σ_α·rms β)² + (σ_β·rms α)²) with each σ the white noise the common filter passes. A
+    sequential three-axis maneuver (stabilator, then aileron, then rudder) gives 1.6-2.8; the
+    outside sweep's c172x three-axis maneuvers, where its α follows the lateral motion, 9-10;
+    the project's coupled maneuver 19."""
+    reg = regressors(p)
+    k = max(1, int(round(1.0 / p.dt)))
+    a, b = reg["alpha"][k:-k], reg["beta"][k:-k]
+    product = a * b
+    X = np.column_stack([np.ones_like(a), a, b])
+    rest = product - X @ np.linalg.lstsq(X, product, rcond=None)[0]
+    na = filtered_noise_std(p.noise_std.get("alpha", 0.0), p.weights)
+    nb = filtered_noise_std(p.noise_std.get("beta", 0.0), p.weights)
+    noise = float(np.hypot(na * np.sqrt(np.mean(b ** 2)), nb * np.sqrt(np.mean(a ** 2))))
+    return float(np.sqrt(np.mean(rest ** 2))) / max(noise, 1e-300)
+
+
+def _not_together(p: Prepared) -> str:
+    """Why an α·β term is not offered ('' when it is)."""
+    ratio = joint_excitation(p)
+    if ratio >= JOINT_SNR:
+        return ""
+    return (f"α and β never moved together: their product, beyond what α and β themselves carry, stands "
+            f"{ratio:.1f} times above the noise it picks up from them (needs {JOINT_SNR:g})")
 
 
 def contribution_share(column: np.ndarray, coefficient: float, measured: np.ndarray) -> float:
