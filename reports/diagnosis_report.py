@@ -528,7 +528,8 @@ def _calibration_table(data: Mapping) -> Table | None:
 
 def _unconfirmed_table(data: Mapping) -> Table | None:
     """Terms the identification maneuver called for that the validation maneuver did not
-    confirm (findings.json's ``not_confirmed``): reported, not findings, not modelled."""
+    confirm, or the calibration in the loop did not support (findings.json's
+    ``not_confirmed``): reported, not findings, not modelled."""
     rows = [{"effect": str(f.get("effect", "")), "parameter": _scalar(f.get("parameter")),
              "estimate": _num(f.get("estimate")), "std_error": _num(f.get("std_error")),
              "units": _scalar(f.get("units")),
@@ -540,8 +541,8 @@ def _unconfirmed_table(data: Mapping) -> Table | None:
     return Table("Not confirmed", pd.DataFrame(rows),
                  "Terms the identification maneuver called for but the validation maneuver did not confirm "
                  "(neutral or contradicted), or could not tell from a rival that fits as well (ambiguous: a "
-                 "collinear candidate of the same axis, see the reason): not findings, and left out of the "
-                 "augmented model.")
+                 "collinear candidate of the same axis, see the reason), or that the calibration in the loop "
+                 "sized at nothing (unsupported): not findings, and left out of the augmented model.")
 
 
 def _located_lines(located: Mapping) -> tuple[str, ...]:
