@@ -218,3 +218,32 @@ def test_an_alpha_beta_term_needs_alpha_and_beta_to_move_together():
     keep, skipped = offered(apart, [term])
     assert keep == [] and skipped[0].details["not_offered"].startswith("α and β never moved together")
     assert offered(together, [term])[0] == [term]
+
+
+def test_vanes_at_the_positions_the_metadata_give_are_carried_to_the_cg():
+    """prepare.vanes_at_cg: a vane r = (x, y, z) ft from the c.g. reads α + (p·y − q·x)/V and
+    β + (r·x − p·z)/V; the metadata's positions undo it exactly (to first order, as the
+    reading was made), move to meta['vanes_at_cg'], and a second call changes nothing; a
+    recording without vane positions is returned as it is."""
+    import numpy as np
+    import pandas as pd
+
+    from harness.diagnosis.prepare import vanes_at_cg
+    from maneuvers.recording import Recording
+    n = 50
+    t = np.arange(n) * 0.02
+    alpha, beta = 0.05 + 0.01 * np.sin(t), 0.002 * np.cos(t)
+    p, q, r, V = 0.1 * np.sin(3 * t), 0.05 * np.cos(2 * t), 0.02 * np.sin(t), np.full(n, 400.0)
+    xa, ya, xb, zb = 15.0, 1.0, 14.0, -2.0
+    data = pd.DataFrame({"t_s": t, "V_fps": V, "alpha_rad": alpha + (p * ya - q * xa) / V,
+                         "beta_rad": beta + (r * xb - p * zb) / V, "p_rps": p, "q_rps": q, "r_rps": r})
+    meta = {"sensors": {"accelerometer_ft": [0.0, 0.0, 0.0], "alpha_vane_ft": [xa, ya, 0.0],
+                        "beta_vane_ft": [xb, 0.0, zb]}}
+    rec = vanes_at_cg(Recording(data=data, meta=meta, name="r"))
+    assert np.allclose(rec.data["alpha_rad"], alpha, atol=1e-15) and np.allclose(rec.data["beta_rad"], beta, atol=1e-15)
+    assert rec.meta["vanes_at_cg"] == {"alpha_vane_ft": [xa, ya, 0.0], "beta_vane_ft": [xb, 0.0, zb]}
+    assert rec.meta["sensors"]["alpha_vane_ft"] == [0.0, 0.0, 0.0]
+    again = vanes_at_cg(rec)
+    assert again is rec
+    plain = Recording(data=data, meta={"sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]}}, name="r")
+    assert vanes_at_cg(plain) is plain

@@ -300,13 +300,15 @@ class Convention:
     actuator_rps: float = 40.0     # the second-order actuators' natural frequency (ζ 0.7)
     duration_s: float = DURATION_S
     units: str = "canonical"       # or 'deg-kts': angles in deg, rates in deg/s, V in kts, h in m
+    vanes_ft: float = 0.0          # both vanes this far ahead of the c.g., the position in the metadata
 
     def describe(self) -> str:
         """The departures from the usual recording, '' for none."""
         base = Convention()
         words = {"inputs": lambda v: v, "rate_hz": lambda v: f"{v:g} Hz", "white_scale": lambda v: f"noise x{v:g}",
                  "gauss_markov_deg": lambda v: f"vane wander {v:g} deg", "actuator_rps": lambda v: f"actuator {v:g} rad/s",
-                 "duration_s": lambda v: f"{v:g} s", "units": lambda v: v}
+                 "duration_s": lambda v: f"{v:g} s", "units": lambda v: v,
+                 "vanes_ft": lambda v: f"vanes {v:g} ft ahead"}
         return ", ".join(words[k](getattr(self, k)) for k in words if getattr(self, k) != getattr(base, k))
 
 
@@ -459,7 +461,7 @@ def _twin_otter_cases() -> list[OutsideCase]:
 def _convention_cases() -> list[OutsideCase]:
     """Recordings in conventions the project's own never use (:class:`Convention`): multisine
     and sweep inputs, 25 and 100 Hz, twice the noise, a wider vane wander, slower actuators,
-    15 and 60 s, other units. Mostly nulls (what goes wrong is the point), and a few effects
+    15 and 60 s, other units, vanes on a nose boom (their position in the metadata). Mostly nulls (what goes wrong is the point), and a few effects
     (their own drops and seeds, so the other cases stay as they were)."""
     spec = [  # where, kind, convention, effect (None: a null), parameter, truth, channel
         ("S", "three_axis", Convention(inputs="multisine"), None),
@@ -485,6 +487,10 @@ def _convention_cases() -> list[OutsideCase]:
          (H("sensor_bias", 0.5 * DEG, channel="q"), "bias_q", 0.5 * DEG, "q")),
         ("S", "three_axis", Convention(actuator_rps=20.0), (H("cg_offset", 1.0), "dx_moment_reference", 1.0, "q")),
         ("L", "pitch", Convention(units="deg-kts"), (H("unsteady_alphadot", -3.0), "Cm_alphadot", -3.0, "q")),
+        ("S", "three_axis", Convention(vanes_ft=15.0), None),
+        ("L", "pitch", Convention(vanes_ft=15.0), None),
+        ("M", "lateral", Convention(vanes_ft=15.0), None),
+        ("S", "pitch", Convention(vanes_ft=15.0), (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):
@@ -559,8 +565,16 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
                           duration_s=max(cv.duration_s, inp.duration_s), loop=cond.loop, sample_rate_hz=cv.rate_hz)
         if c.turbulence is not None:
             spec = replace(spec, turbulence=c.turbulence, turbulence_seed=100 * c.seed + i)
-        rec, answer = postprocess(fly_maneuver(spec), noise=not c.clean, seed=1000 * c.seed + i, drop=c.drop,
+        flight = fly_maneuver(spec)
+        if cv.vanes_ft:
+            flight = vanes_ahead(flight, cv.vanes_ft)
+        rec, answer = postprocess(flight, noise=not c.clean, seed=1000 * c.seed + i, drop=c.drop,
                                   mode=c.mode, aircraft_label=label, noise_model=noise)
+        if cv.vanes_ft:  # the team knows where its nose boom is
+            pos = [cv.vanes_ft, 0.0, 0.0]
+            rec = Recording(data=rec.data, meta={**rec.meta, "sensors": {**(rec.meta.get("sensors") or {}),
+                                                                         "alpha_vane_ft": pos, "beta_vane_ft": pos}},
+                            name=rec.name)
         paths[role] = write_recording(rec, out_dir / f"{c.name}-{role}.csv")
         if cv.units != "canonical":  # the writer writes canonical units only; the reader takes these
             rewrite_in_units(paths[role], OTHER_UNITS)
@@ -579,6 +593,16 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
 # The 'deg-kts' convention: every quantity that has one in recording-format.md's table in its
 # other accepted unit (angles in deg, rates in deg/s, airspeed in kts, altitude in m).
 OTHER_UNITS = {"rad": "deg", "rps": "dps", "V_fps": "kts", "h_ft": "m"}
+
+
+def vanes_ahead(rec: Recording, x_ft: float) -> Recording:
+    """A flight's α and β as vanes ``x_ft`` ahead of the c.g. read them: α − x·q/V, β + x·r/V
+    (the air's velocity at the vane is the c.g.'s plus ω × r; to first order in the rates)."""
+    d = rec.data.copy()
+    V = d["V_fps"].to_numpy(dtype=float)
+    d["alpha_rad"] = d["alpha_rad"].to_numpy(dtype=float) - x_ft * d["q_rps"].to_numpy(dtype=float) / V
+    d["beta_rad"] = d["beta_rad"].to_numpy(dtype=float) + x_ft * d["r_rps"].to_numpy(dtype=float) / V
+    return Recording(data=d, meta=rec.meta, name=rec.name)
 
 
 def rewrite_in_units(path: Path, units: dict[str, str]) -> None:

@@ -105,6 +105,42 @@ def clean_channels(p: Prepared, names=None) -> dict[str, np.ndarray]:
     return {c: p.raw[c] - p.own_noise[c] if c in p.own_noise else p.raw[c] for c in (names or p.raw)}
 
 
+# The metadata keys of the vanes' positions (recording-format.md: "Other sensor positions
+# (alpha_vane_ft, ...) may be added the same way"), ft from the c.g. in body axes.
+VANE_KEYS = {"alpha": "alpha_vane_ft", "beta": "beta_vane_ft"}
+
+
+def vanes_at_cg(rec: Recording) -> Recording:
+    """``rec`` with α and β read at the vane positions its metadata give carried to the c.g.
+    (unchanged when none is given or it was done already).
+
+    The air's velocity at a vane r = (x, y, z) ft from the c.g. is the c.g.'s plus ω × r, so
+    to first order in the rates α_vane = α + (p·y − q·x)/V and β_vane = β + (r·x − p·z)/V (a
+    nose-boom vane 15 ft ahead reads α low by 15·q/V); the recorded rates and airspeed undo
+    it. The positions move to ``meta['vanes_at_cg']``, and ``sensors`` holds them at zero, so
+    a second call does nothing. Measured on F-16 recordings with both vanes 15 ft ahead, the
+    positions declared: taken at the c.g., the diagnosis named a vane 20 ± 3 ft ahead on a
+    pitch maneuver and an accelerometer 17 ft aft on a three-axis one; carried, nothing."""
+    sensors = dict(rec.meta.get("sensors") or {})
+    given = {c: [float(v) for v in sensors[k]] for c, k in VANE_KEYS.items()
+             if k in sensors and any(float(v) != 0.0 for v in sensors[k])}
+    if not given:
+        return rec
+    d = rec.data.copy()
+    V = d["V_fps"].to_numpy(dtype=float)
+    p, q, r = (d[f"{c}_rps"].to_numpy(dtype=float) for c in ("p", "q", "r"))
+    if "alpha" in given:
+        x, y, _ = given["alpha"]
+        d["alpha_rad"] = d["alpha_rad"].to_numpy(dtype=float) - (p * y - q * x) / V
+    if "beta" in given:
+        x, _, z = given["beta"]
+        d["beta_rad"] = d["beta_rad"].to_numpy(dtype=float) - (r * x - p * z) / V
+    meta = dict(rec.meta)
+    meta["vanes_at_cg"] = {VANE_KEYS[c]: pos for c, pos in given.items()}
+    meta["sensors"] = {**sensors, **{VANE_KEYS[c]: [0.0, 0.0, 0.0] for c in given}}
+    return Recording(data=d, meta=meta, name=rec.name)
+
+
 def _channels(rec: Recording) -> dict[str, np.ndarray]:
     out = {}
     for q, unit in UNITS.items():
@@ -146,6 +182,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     ValueError
         When the recording is too short (under 4 s) or lacks what Eqs. 1-5 need.
     """
+    rec = vanes_at_cg(rec)
     raw = _channels(rec)
     t = rec.data["t_s"].to_numpy(dtype=float)
     t = t - t[0]
@@ -208,8 +245,16 @@ def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...])
     if "accelerometer_ft" not in sensors:
         out.append({"item": "accelerometer position", "missing": "sensors.accelerometer_ft",
                     "stood_in_by": "at the c.g. (any offset is then a finding, sensor_offset)"})
-    out.append({"item": "angle-of-attack and sideslip vanes", "missing": "vane positions",
-                "stood_in_by": "α and β taken as measured at the c.g. (a vane offset is then a finding)"})
+    moved = meta.get("vanes_at_cg") or {}
+    if moved:
+        where = ", ".join(f"{k} {v}" for k, v in moved.items())
+        out.append({"item": "angle-of-attack and sideslip vanes", "missing": "-",
+                    "stood_in_by": f"carried to the c.g. from the metadata's positions ({where}) with the recorded "
+                                   "rates and airspeed (α − (p·y − q·x)/V, β − (r·x − p·z)/V)"
+                                   + ("" if len(moved) == 2 else "; the other vane taken at the c.g.")})
+    else:
+        out.append({"item": "angle-of-attack and sideslip vanes", "missing": "vane positions",
+                    "stood_in_by": "α and β taken as measured at the c.g. (a vane offset is then a finding)"})
     out.append({"item": "angular rates", "missing": "-",
                 "stood_in_by": "p, q, r taken as the body rates the aerodynamics see (still air; inertial and "
                                "Earth-relative rates differ by at most 7.3e-5 rad/s)"})
