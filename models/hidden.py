@@ -260,6 +260,16 @@ def offset_accelerometer(channels: dict[str, np.ndarray], r_ft: tuple[float, flo
         channels[c] = channels[c] + extra[:, i]
 
 
+def vane_shift(p, q, r, V, position_ft) -> tuple[np.ndarray, np.ndarray]:
+    """What vanes at ``position_ft`` (x, y, z ft from the c.g., body axes) read beyond the
+    c.g.'s α and β: the air's velocity there is the c.g.'s plus ω × r, so to first order in
+    the rates Δα = (p·y − q·x)/V and Δβ = (r·x − p·z)/V (a vane 15 ft ahead reads α low by
+    15·q/V). Rates in rad/s, V in ft/s; arrays or scalars."""
+    x, y, z = (float(c) for c in position_ft)
+    p, q, r, V = (np.asarray(v, dtype=float) for v in (p, q, r, V))
+    return (p * y - q * x) / V, (r * x - p * z) / V
+
+
 _UNITS = {"alpha": "rad", "beta": "rad", "V": "fps", "p": "rps", "q": "rps", "r": "rps", "phi": "rad",
           "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
 

@@ -3,7 +3,6 @@ candidate test, gathered into scored candidates."""
 from __future__ import annotations
 
 import functools
-
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
@@ -147,20 +146,19 @@ def _turbulence(p: Prepared):
     return gust, turbulent
 
 
-def light_gusts(gust, p: Prepared, V0: float, factor: float | None = None) -> str:
+def light_gusts(gust, p: Prepared, V0: float) -> str:
     """Why gusts too light to name as turbulence still leave the kinematic consistency the
     sensor tests rest on untrustworthy ('' when they do not): the kinematic residual stands
     :data:`GUST_RATIO` times above what sensor noise gives, and the gust angle it implies,
-    σ/V, is at least ``factor`` (default :data:`GUST_ANGLE_FACTOR`) times the white noise of
-    the α and β vanes. The same gust is a larger angle the slower the aircraft: 1.9 ft/s at
-    180 ft/s is 0.6 deg, six times a 0.1 deg vane's noise, and there (Dryden severity 2) the
-    kinematics named an α-vane skew and position on a c172x null, and an accelerometer 15 ft
-    aft on a DHC-6 null (outside sweep probes, 2 Dec 2026)."""
-    factor = GUST_ANGLE_FACTOR if factor is None else factor
+    σ/V, is at least :data:`GUST_ANGLE_FACTOR` times the white noise of the α and β vanes
+    (counted at no less than :data:`VANE_NOISE_FLOOR_RAD`). The same gust is a larger angle
+    the slower the aircraft: 1.9 ft/s at 180 ft/s is 0.6 deg, six times a 0.1 deg vane's
+    noise, and there (Dryden severity 2) the kinematics named an α-vane skew and position on
+    a c172x null, and an accelerometer 15 ft aft on a DHC-6 null (outside sweep, 2 Dec 2026)."""
     sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
     vane = max(float(np.mean([p.noise_std.get(c, 0.0) for c in ("alpha", "beta")])), VANE_NOISE_FLOOR_RAD)
     angle = sigma / max(V0, 1e-9)
-    if gust.ratio_to_noise < GUST_RATIO or angle < factor * vane:
+    if gust.ratio_to_noise < GUST_RATIO or angle < GUST_ANGLE_FACTOR * vane:
         return ""
     return (f"gusts of about {sigma:.1f} ft/s ({np.degrees(angle):.2f} deg of angle at {V0:.0f} ft/s, "
             f"{angle / vane:.1f} times the vanes' noise; too light to name as turbulence) break the kinematic "

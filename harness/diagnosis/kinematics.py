@@ -25,6 +25,7 @@ import numpy as np
 from estimators.colored_stepwise import ColoredSelection, colored_forward_selection
 from harness.diagnosis.prepare import Prepared, clean_channels
 from models.constants import G0_FPS2 as G0
+from models.hidden import vane_shift
 
 EARTH_RADIUS_FT = 20_925_646.3
 BIAS_CHANNELS = ("alpha", "beta", "V", "p", "q", "r", "phi", "theta", "ax", "ay", "az")
@@ -100,10 +101,9 @@ def _accel_offset_corrected(axis: int, ch: dict, p: Prepared, th: float) -> dict
 
 
 def _vane_corrected(c: str, ch: dict, p: Prepared, th: float) -> dict:
-    # a vane x ft ahead of the c.g.: α_v = α − x q/V, β_v = β + x r/V
-    if c == "alpha":
-        return _with(ch, "alpha", ch["alpha"] + th * ch["q"] / ch["V"])
-    return _with(ch, "beta", ch["beta"] - th * ch["r"] / ch["V"])
+    # a vane th ft ahead of the c.g. (models.hidden.vane_shift: α_v = α − x q/V, β_v = β + x r/V)
+    shift = vane_shift(ch["p"], ch["q"], ch["r"], ch["V"], (th, 0.0, 0.0))[0 if c == "alpha" else 1]
+    return _with(ch, c, ch[c] - shift)
 
 
 def _bias(c: str) -> Callable:

@@ -57,7 +57,7 @@ from maneuvers.recording import Recording
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence
 from models.flight import Loop
-from models.hidden import HiddenEffect as H
+from models.hidden import HiddenEffect as H, vane_shift
 
 DEG = math.pi / 180.0
 EARTH_RATE_RPS = 7.292115e-5  # WGS-84, as JSBSim
@@ -306,7 +306,8 @@ class Convention:
         """The departures from the usual recording, '' for none."""
         base = Convention()
         words = {"inputs": lambda v: v, "rate_hz": lambda v: f"{v:g} Hz", "white_scale": lambda v: f"noise x{v:g}",
-                 "gauss_markov_deg": lambda v: f"vane wander {v:g} deg", "actuator_rps": lambda v: f"actuator {v:g} rad/s",
+                 "gauss_markov_deg": lambda v: f"vane wander {v:g} deg",
+                 "actuator_rps": lambda v: f"actuator {v:g} rad/s",
                  "duration_s": lambda v: f"{v:g} s", "units": lambda v: v,
                  "vanes_ft": lambda v: f"vanes {v:g} ft ahead"}
         return ", ".join(words[k](getattr(self, k)) for k in words if getattr(self, k) != getattr(base, k))
@@ -340,6 +341,11 @@ class OutsideCase:
 def _drops(i: int) -> tuple[str, ...]:
     """Every third case lacks the altitude channel, every third (shifted) the thrust."""
     return {0: (), 1: ("h",), 2: ("thrust",)}[i % 3]
+
+
+def _size_label(truth: float) -> str:
+    """A case name's size: as given, or in degrees when it is a small angle (0.5deg)."""
+    return f"{truth:g}" if abs(truth) >= 0.01 or truth == 0 else f"{truth / DEG:g}deg"
 
 
 def cases() -> tuple[OutsideCase, ...]:
@@ -411,7 +417,7 @@ def cases() -> tuple[OutsideCase, ...]:
     ]
     out: list[OutsideCase] = []
     for where, kind, e, param, truth, ch in spec:
-        label = f"{truth:g}" if abs(truth) >= 0.01 or truth == 0 else f"{truth / DEG:g}deg"
+        label = _size_label(truth)
         out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{label}", where, kind, (e,), e.effect, param,
                                truth, ch))
     mode, small_mode = StructuralMode(8.0, 0.02, 0.5, 3.0), StructuralMode(7.0, 0.03, 0.3, 2.0)
@@ -450,9 +456,8 @@ def _twin_otter_cases() -> list[OutsideCase]:
         ("three_axis", H("cg_offset", 0.5), "dx_moment_reference", 0.5, "q"),
         ("three_axis", H("sensor_bias", 1.0 * DEG, channel="beta"), "bias_beta", 1.0 * DEG, "beta"),
     ]
-    out = [OutsideCase(f"D_{kind}_{e.effect}_{param}_{truth:g}" if abs(truth) >= 0.01
-                       else f"D_{kind}_{e.effect}_{param}_{truth / DEG:g}deg", "D", kind, (e,), e.effect, param, truth, ch)
-           for kind, e, param, truth, ch in spec]
+    out = [OutsideCase(f"D_{kind}_{e.effect}_{param}_{_size_label(truth)}", "D", kind, (e,), e.effect, param, truth,
+                       ch) for kind, e, param, truth, ch in spec]
     out += [OutsideCase(f"D_{kind}_none_s{seed}", "D", kind, seed=seed)
             for kind, seed in (("pitch", 15), ("lateral", 16), ("three_axis", 17))]
     return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
@@ -461,8 +466,9 @@ def _twin_otter_cases() -> list[OutsideCase]:
 def _convention_cases() -> list[OutsideCase]:
     """Recordings in conventions the project's own never use (:class:`Convention`): multisine
     and sweep inputs, 25 and 100 Hz, twice the noise, a wider vane wander, slower actuators,
-    15 and 60 s, other units, vanes on a nose boom (their position in the metadata). Mostly nulls (what goes wrong is the point), and a few effects
-    (their own drops and seeds, so the other cases stay as they were)."""
+    15 and 60 s, other units, vanes on a nose boom (their position in the metadata). Mostly
+    nulls (what goes wrong is the point), and a few effects (their own drops and seeds, so the
+    other cases stay as they were)."""
     spec = [  # where, kind, convention, effect (None: a null), parameter, truth, channel
         ("S", "three_axis", Convention(inputs="multisine"), None),
         ("L", "pitch", Convention(inputs="sweep"), None),
@@ -490,7 +496,8 @@ def _convention_cases() -> list[OutsideCase]:
         ("S", "three_axis", Convention(vanes_ft=15.0), None),
         ("L", "pitch", Convention(vanes_ft=15.0), None),
         ("M", "lateral", Convention(vanes_ft=15.0), None),
-        ("S", "pitch", Convention(vanes_ft=15.0), (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
+        ("S", "pitch", Convention(vanes_ft=15.0),
+         (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):
@@ -499,7 +506,7 @@ def _convention_cases() -> list[OutsideCase]:
             out.append(OutsideCase(f"{where}_{kind}_none_{tag}", where, kind, seed=40 + i, convention=cv))
             continue
         e, param, truth, ch = effect
-        label = f"{truth:g}" if abs(truth) >= 0.01 else f"{truth / DEG:g}deg"
+        label = _size_label(truth)
         out.append(OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{label}_{tag}", where, kind, (e,), e.effect,
                                param, truth, ch, seed=40 + i, convention=cv))
     return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
@@ -515,7 +522,7 @@ def _airliner_cases() -> list[OutsideCase]:
             ("pitch", H("sensor_bias", 0.5 * DEG, channel="q"), "bias_q", 0.5 * DEG, "q")]
     out = []
     for i, (kind, e, param, truth, ch) in enumerate(spec):
-        label = f"{truth:g}" if abs(truth) >= 0.01 else f"{truth / DEG:g}deg"
+        label = _size_label(truth)
         out.append(OutsideCase(f"B_{kind}_{e.effect}_{param}_{label}", "B", kind, (e,), e.effect, param, truth, ch,
                                seed=90 + i))
     out += [OutsideCase(f"B_{kind}_none_s{95 + i}", "B", kind, seed=95 + i)
@@ -596,12 +603,12 @@ OTHER_UNITS = {"rad": "deg", "rps": "dps", "V_fps": "kts", "h_ft": "m"}
 
 
 def vanes_ahead(rec: Recording, x_ft: float) -> Recording:
-    """A flight's α and β as vanes ``x_ft`` ahead of the c.g. read them: α − x·q/V, β + x·r/V
-    (the air's velocity at the vane is the c.g.'s plus ω × r; to first order in the rates)."""
+    """A flight's α and β as vanes ``x_ft`` ahead of the c.g. read them
+    (:func:`models.hidden.vane_shift`)."""
     d = rec.data.copy()
-    V = d["V_fps"].to_numpy(dtype=float)
-    d["alpha_rad"] = d["alpha_rad"].to_numpy(dtype=float) - x_ft * d["q_rps"].to_numpy(dtype=float) / V
-    d["beta_rad"] = d["beta_rad"].to_numpy(dtype=float) + x_ft * d["r_rps"].to_numpy(dtype=float) / V
+    da, db = vane_shift(*(d[c].to_numpy(dtype=float) for c in ("p_rps", "q_rps", "r_rps", "V_fps")), (x_ft, 0.0, 0.0))
+    d["alpha_rad"] = d["alpha_rad"].to_numpy(dtype=float) + da
+    d["beta_rad"] = d["beta_rad"].to_numpy(dtype=float) + db
     return Recording(data=d, meta=rec.meta, name=rec.name)
 
 

@@ -11,6 +11,7 @@ from estimators.smoothing import optimal_fourier_smoother, sine_series_derivativ
 from harness.isa import density_altitude_ft
 from maneuvers.recording import Recording
 from models.constants import BODY_COEFFICIENTS, SURFACES
+from models.hidden import vane_shift
 from models.replay import START_WINDOW_S
 
 OUTPUTS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
@@ -114,11 +115,10 @@ def vanes_at_cg(rec: Recording) -> Recording:
     """``rec`` with α and β read at the vane positions its metadata give carried to the c.g.
     (unchanged when none is given or it was done already).
 
-    The air's velocity at a vane r = (x, y, z) ft from the c.g. is the c.g.'s plus ω × r, so
-    to first order in the rates α_vane = α + (p·y − q·x)/V and β_vane = β + (r·x − p·z)/V (a
-    nose-boom vane 15 ft ahead reads α low by 15·q/V); the recorded rates and airspeed undo
-    it. The positions move to ``meta['vanes_at_cg']``, and ``sensors`` holds them at zero, so
-    a second call does nothing. Measured on F-16 recordings with both vanes 15 ft ahead, the
+    A vane away from the c.g. reads the shift :func:`models.hidden.vane_shift` gives (to first
+    order in the rates, from ω × r); the recorded rates and airspeed undo it. The positions
+    move to ``meta['vanes_at_cg']``, and ``sensors`` holds them at zero, so a second call does
+    nothing. Measured on F-16 recordings with both vanes 15 ft ahead, the
     positions declared: taken at the c.g., the diagnosis named a vane 20 ± 3 ft ahead on a
     pitch maneuver and an accelerometer 17 ft aft on a three-axis one; carried, nothing."""
     sensors = dict(rec.meta.get("sensors") or {})
@@ -127,14 +127,10 @@ def vanes_at_cg(rec: Recording) -> Recording:
     if not given:
         return rec
     d = rec.data.copy()
-    V = d["V_fps"].to_numpy(dtype=float)
-    p, q, r = (d[f"{c}_rps"].to_numpy(dtype=float) for c in ("p", "q", "r"))
-    if "alpha" in given:
-        x, y, _ = given["alpha"]
-        d["alpha_rad"] = d["alpha_rad"].to_numpy(dtype=float) - (p * y - q * x) / V
-    if "beta" in given:
-        x, _, z = given["beta"]
-        d["beta_rad"] = d["beta_rad"].to_numpy(dtype=float) - (r * x - p * z) / V
+    rates = [d[c].to_numpy(dtype=float) for c in ("p_rps", "q_rps", "r_rps", "V_fps")]
+    for c, pos in given.items():
+        col = f"{c}_rad"
+        d[col] = d[col].to_numpy(dtype=float) - vane_shift(*rates, pos)[0 if c == "alpha" else 1]
     meta = dict(rec.meta)
     meta["vanes_at_cg"] = {VANE_KEYS[c]: pos for c, pos in given.items()}
     meta["sensors"] = {**sensors, **{VANE_KEYS[c]: [0.0, 0.0, 0.0] for c in given}}
@@ -148,6 +144,13 @@ def _channels(rec: Recording) -> dict[str, np.ndarray]:
         if col in rec.data.columns:
             out[q] = rec.data[col].to_numpy(dtype=float)
     return out
+
+
+def about_trend(x: np.ndarray) -> float:
+    """The standard deviation of ``x`` about the line through its end points: the signal the
+    sine-series filter smooths (it removes that line first)."""
+    x = np.asarray(x, dtype=float)
+    return float(np.std(x - np.linspace(x[0], x[-1], x.size)))
 
 
 def common_weights(fits: dict, excited: tuple[str, ...], n: int) -> np.ndarray:
@@ -169,9 +172,8 @@ def common_weights(fits: dict, excited: tuple[str, ...], n: int) -> np.ndarray:
 
 def _own_snr(fit) -> float:
     """A channel's own optimal smoothing over the white noise that smoothing lets through."""
-    x = fit.smoothed
-    signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
-    return signal / max(filtered_noise_std(float(np.sqrt(max(fit.noise_variance, 0.0))), fit.weights), 1e-12)
+    noise = filtered_noise_std(float(np.sqrt(max(fit.noise_variance, 0.0))), fit.weights)
+    return about_trend(fit.smoothed) / max(noise, 1e-12)
 
 
 def prepare(rec: Recording, name: str = "identification") -> Prepared:
@@ -192,9 +194,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     assumptions = list(_stand_ins(raw, rec.meta, tuple(rec.data.columns)))
     fits = {c: optimal_fourier_smoother(x, dt) for c, x in raw.items()}
     noise = {c: float(np.sqrt(max(f.noise_variance, 0.0))) for c, f in fits.items()}
-    excited = tuple(c for c, f in fits.items()
-                    if np.std(f.smoothed - np.linspace(f.smoothed[0], f.smoothed[-1], t.size))
-                    > 5.0 * max(noise[c], 1e-12))
+    excited = tuple(c for c, f in fits.items() if about_trend(f.smoothed) > 5.0 * max(noise[c], 1e-12))
     w = common_weights(fits, excited, t.size)
     smooth = {c: sine_series_filter(x, w) for c, x in raw.items()}
     deriv = {c: sine_series_derivative(x, w, dt) for c, x in raw.items()}
@@ -280,8 +280,7 @@ def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weig
     group's input (a lateral input's spiral, turbulence) is not driven: the model is evaluated
     along it (:func:`drifted_states`), no term is built on it."""
     def ratio(c: str) -> float:
-        x = smooth[c]
-        signal = float(np.std(x - np.linspace(x[0], x[-1], x.size)))
+        signal = about_trend(smooth[c])
         if signal < DRIVEN_FLOOR.get(c, 0.0):
             return 0.0
         return signal / max(filtered_noise_std(noise.get(c, 0.0), weights), 1e-12)
@@ -321,8 +320,7 @@ def drifted_states(smooth: dict[str, np.ndarray], noise: dict[str, float], weigh
         if c in driven or c not in smooth:
             continue
         x = smooth[c]
-        signal = max(float(np.std(x - np.linspace(x[0], x[-1], x.size))),
-                     float(np.sqrt(np.mean((x - np.mean(x[:start_samples])) ** 2))))
+        signal = max(about_trend(x), float(np.sqrt(np.mean((x - np.mean(x[:start_samples])) ** 2))))
         if signal >= max(SELF_EVIDENT_SNR * filtered_noise_std(noise.get(c, 0.0), weights),
                          DRIVEN_FLOOR.get(c, 0.0)):
             out.append(c)
