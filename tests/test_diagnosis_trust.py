@@ -247,3 +247,23 @@ def test_vanes_at_the_positions_the_metadata_give_are_carried_to_the_cg():
     assert again is rec
     plain = Recording(data=data, meta={"sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]}}, name="r")
     assert vanes_at_cg(plain) is plain
+
+
+def test_the_kinematics_refute_a_vane_scale_they_do_not_see():
+    """analysis._kinematics_refute: a C_Z,α error looks like an α-vane scale to the coefficient
+    mismatch alone; the kinematics' own estimate of that scale, 4.5 combined standard errors
+    away (the project sweep's C_Z,α case), refutes it; 2.5 apart (a true 0.08 scale at 700
+    ft/s) does not; nor does a scale the kinematics never tried."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import VANE_REFUTE_Z, _kinematics_refute
+
+    def kin(v, se):
+        term = SimpleNamespace(name="scale_alpha", estimate=v, t=v / se)
+        return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[term]))
+    assert VANE_REFUTE_Z == 3.5
+    why = _kinematics_refute(kin(0.0033, 0.011), "scale_alpha", -0.069, 0.0115)
+    assert "kinematics put that scale at 0.003" in why
+    assert _kinematics_refute(kin(0.066, 0.032), "scale_alpha", 0.166, 0.024) == ""
+    assert _kinematics_refute(SimpleNamespace(selection=SimpleNamespace(params={}, terms=[])), "scale_alpha",
+                              -0.069, 0.0115) == ""

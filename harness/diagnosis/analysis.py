@@ -715,6 +715,11 @@ def _withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: _St
         ag = corroborate.imitates(signature(name, PROBE_SCALE, same), t_aero=cand.T_IN)
         if ag is None or not is_plausible(name, ag.ratio * PROBE_SCALE, 1.0):
             continue
+        refuted = _kinematics_refute(kin, name, ag.ratio * PROBE_SCALE, ag.std_error * PROBE_SCALE)
+        if refuted:
+            for c in chosen:
+                c.details["vane_scale_refuted"] = refuted
+            continue
         for c in chosen:
             c.selected = False
             c.details["sensor_rival"] = name
@@ -722,6 +727,30 @@ def _withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: _St
             c.reason = (f"entered, but not named: an {x} vane scale error of k = {ag.ratio * PROBE_SCALE:.3f} would "
                         f"explain the mismatch on every axis that can tell alike (k from {each}), in the model's own "
                         "proportions, which a wrong derivative on one axis does not")
+
+
+# How far (in combined standard errors) the kinematics' own estimate of a vane's scale may
+# sit from the scale the coefficient mismatch asks for before they refute it. The mismatch's
+# k and the kinematic one come from independent equations; on the project sweep a C_Z,α error
+# asked for k = -0.069 ± 0.012 against a kinematic 0.003 ± 0.011 (4.5 apart), while a true
+# 0.08 scale at 700 ft/s asked for 0.166 ± 0.024 against a kinematic 0.066 ± 0.032 (2.5).
+VANE_REFUTE_Z = 3.5
+
+
+def _kinematics_refute(kin: KinematicResult, name: str, k: float, k_std: float) -> str:
+    """Why the kinematics refute a vane scale ``k ± k_std`` the coefficient mismatch asks for:
+    their own estimate of ``name`` sits more than :data:`VANE_REFUTE_Z` combined standard
+    errors from it; an empty string when they do not (or cannot tell)."""
+    found = _kin_estimate(kin, name)
+    if found is None or found[1] <= 0:
+        return ""
+    v, t = found
+    se = abs(v) / t
+    z = abs(k - v) / float(np.hypot(se, k_std))
+    if not np.isfinite(z) or z < VANE_REFUTE_Z:
+        return ""
+    return (f"an {name.split('_', 1)[1]} vane scale of k = {k:.3f} ± {k_std:.3f} would imitate it, but the "
+            f"kinematics put that scale at {v:.3f} ± {se:.3f} ({z:.1f} standard errors apart)")
 
 
 def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature, applied: set[str],
