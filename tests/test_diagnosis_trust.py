@@ -267,3 +267,58 @@ def test_the_kinematics_refute_a_vane_scale_they_do_not_see():
     assert _kinematics_refute(kin(0.066, 0.032), "scale_alpha", 0.166, 0.024) == ""
     assert _kinematics_refute(SimpleNamespace(selection=SimpleNamespace(params={}, terms=[])), "scale_alpha",
                               -0.069, 0.0115) == ""
+
+
+def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypatch):
+    """analysis.name_replicated: the same instrument flew both maneuvers, so an a_z bias the
+    identification's kinematics put at 0.027 ± 0.0058 (t 4.7) and the validation's at
+    0.027 ± 0.0042 (t 6.3 there, but below the entry t on the identification) is named at
+    their inverse-variance combination; opposite signs, sizes more than two standard errors
+    apart, a combined t under the entry t, or one maneuver below the suspicion level name
+    nothing; nor a scale (a column that follows the motion), nor anything when another sensor
+    error is named."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis import analysis as an
+    from harness.diagnosis.analysis import Candidate, name_replicated
+    monkeypatch.setattr(an, "_kinematics_trusted", lambda a: True)
+    monkeypatch.setattr(an, "_kinematic_rival", lambda kin, name: None)
+    monkeypatch.setattr(an, "_sensor_verdict", lambda *args: (True, ""))
+
+    def analysis(v, se):
+        c = Candidate("sensor_bias", None, "az", "bias_az", v, se, v / se, 0.0, "g", "kinematic consistency",
+                      reason="below the entry t")
+        return SimpleNamespace(candidates=[c], prepared=None, kinematic=None)
+
+    def with_named_sensor(a):  # a scale named on the identification: its kinematic fit may lack it
+        a.candidates.append(Candidate("sensor_scale", None, "beta", "scale_beta", 0.15, 0.013, 11.3, 0.0, "",
+                                      "kinematic consistency", selected=True))
+        return a
+
+    a, av = analysis(0.027, 0.0058), analysis(0.0266, 0.0042)
+    named = name_replicated(a, av)
+    assert [c.parameter for c in named] == ["bias_az"] and a.candidates[0].selected
+    w1, w2 = 0.0058 ** -2, 0.0042 ** -2
+    assert a.candidates[0].estimate == pytest.approx((w1 * 0.027 + w2 * 0.0266) / (w1 + w2))
+    assert a.candidates[0].std_error == pytest.approx((w1 + w2) ** -0.5)
+    assert a.candidates[0].details["replication"]["validation"] == [0.0266, 0.0042]
+    assert name_replicated(with_named_sensor(analysis(0.027, 0.0058)), analysis(0.0266, 0.0042)) == []
+    scale = analysis(0.027, 0.0058)
+    scale.candidates[0].effect = "sensor_scale"  # a column that follows the motion: not replicated
+    assert name_replicated(scale, analysis(0.0266, 0.0042)) == []
+    for v, se in [(-0.0266, 0.0042),   # opposite sign
+                  (0.06, 0.0042),      # (0.060 - 0.027) / hypot(.0058, .0042) = 4.6 > 2 standard errors apart
+                  (0.0126, 0.0042),    # t 3: combined 0.018 ± 0.0034, t 5.3 < 6
+                  (0.0266, 0.0133)]:   # t 2 on the validation: below the suspicion level
+        a = analysis(0.027, 0.0058)
+        assert name_replicated(a, analysis(v, se)) == [] and not a.candidates[0].selected
+
+
+def test_an_accelerometer_offset_is_explained_along_its_own_axis():
+    """run._offset_direction: a lateral offset is 'right of' or 'left of' the c.g. (y), a
+    vertical one 'below' or 'above' (z, body axes down), the force fit's x 'ahead of'."""
+    from harness.diagnosis.run import _offset_direction
+    assert _offset_direction("offset_y", 3.9) == ("y", "right of")
+    assert _offset_direction("offset_y", -3.9) == ("y", "left of")
+    assert _offset_direction("offset_z", 2.0) == ("z", "below")
+    assert _offset_direction("x_accelerometer", -5.0) == ("x", "behind")

@@ -925,6 +925,70 @@ def _name_if_corroborated(sensor: Candidate, kin: KinematicResult, p: Prepared, 
     return True
 
 
+# The |t| each maneuver's kinematic estimate must reach on its own for a sensor error below
+# the kinematic entry t to be named on the two together (:func:`name_replicated`): the
+# suspicion level of the other sensor rules (:data:`AMBIGUOUS_T`).
+REPLICATED_EACH_T = AMBIGUOUS_T
+
+
+def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
+    """Name the sensor errors that the identification and the validation maneuvers each
+    suspect (kinematic |t| >= :data:`REPLICATED_EACH_T`, below the entry t) with the same
+    sign and sizes within two standard errors, when their inverse-variance combination
+    reaches the kinematic entry t (:data:`kinematics.T_IN`): the same instrument flew both,
+    and their kinematic residuals carry independent noise. Not when either record's
+    kinematics are void (turbulence, light gusts, implausible estimates), when the
+    identification's kinematics cannot tell the parameter from a rival
+    (:func:`_kinematic_rival`), or when the combined size is not practical and precise
+    (:func:`_sensor_verdict`). Returns the candidates of ``a`` it selected.
+
+    Biases only, and only when no other sensor error is named: the replication shows the two
+    records' noise to be independent, not their systematic errors. A real error the kinematic
+    fit leaves out repeats in both records and pushes the columns that follow the same motion
+    alike: beside a β-vane scale of 0.15 (named on the coefficient mismatch, not in the
+    kinematic fit) both maneuvers asked for an r-gyro scale of −0.14 (t −5.4 and −5.8), and a
+    noise-free DHC-6 flight of the model itself for an a_y scale of −0.07 (t −3.8 and −5.6;
+    outside sweep, 2 Dec 2026). A constant is the one column a motion-following error does
+    not imitate alike in two different maneuvers."""
+    if not (_kinematics_trusted(a) and _kinematics_trusted(av)):
+        return []
+    if any(c.selected and c.effect in SENSOR_EFFECTS for c in a.candidates):
+        return []
+    p, kin = a.prepared, a.kinematic
+    twins = {c.parameter: c for c in av.candidates if c.test.startswith("kinematic consistency")}
+    named = []
+    for c in a.candidates:
+        v = twins.get(c.parameter)
+        if (c.selected or v is None or c.reason != "below the entry t" or c.effect != "sensor_bias"
+                or min(abs(c.t), abs(v.t)) < REPLICATED_EACH_T or np.sign(c.estimate) != np.sign(v.estimate)
+                or c.std_error <= 0 or v.std_error <= 0):
+            continue
+        if abs(c.estimate - v.estimate) > 2.0 * np.hypot(c.std_error, v.std_error):
+            continue
+        w1, w2 = c.std_error ** -2, v.std_error ** -2
+        est, se = (w1 * c.estimate + w2 * v.estimate) / (w1 + w2), (w1 + w2) ** -0.5
+        if abs(est) / se < KIN_T_IN or _kinematic_rival(kin, c.parameter) is not None:
+            continue
+        sel, why = _sensor_verdict(c.parameter, est, se, True, kin, p, False, True)
+        if not sel:
+            continue
+        c.details["replication"] = {"identification": [c.estimate, c.std_error],
+                                    "validation": [v.estimate, v.std_error], "combined": [est, se]}
+        c.reason = (f"named on two maneuvers: the identification's kinematics (t = {c.t:.1f}) and the "
+                    f"validation's (t = {v.t:.1f}) agree on it, each below the entry t {KIN_T_IN:g} alone")
+        c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
+        named.append(c)
+    return named
+
+
+def _kinematics_trusted(a: Analysis) -> bool:
+    """Whether a recording's kinematic consistency can judge its sensors: no turbulence
+    named, no light gusts (:func:`light_gusts`), every supported estimate plausible."""
+    turbulent = any(c.effect == "turbulence" and c.selected for c in a.candidates)
+    V0 = float(np.mean(a.prepared.smooth["V"]))
+    return not turbulent and not a.gusty and _kinematics_plausible(a.kinematic, V0)
+
+
 KINEMATIC_PASSES = 4
 
 

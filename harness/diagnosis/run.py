@@ -16,7 +16,7 @@ from scipy import signal
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
-from harness.diagnosis.analysis import Analysis, Candidate, analyse
+from harness.diagnosis.analysis import Analysis, Candidate, analyse, name_replicated
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, vanes_at_cg
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
@@ -38,7 +38,7 @@ EXPLAIN = {
     "control_delay": "The model responds to {channel} too early: the surface acts about {estimate:.3f} ± "
                      "{std_error:.3f} s after the recorded position (an actuator delay the model lacks).",
     "sensor_offset": "The accelerometer is not at the c.g.: its readings carry the rotational terms of a sensor "
-                     "about {abs_estimate:.2f} ± {std_error:.2f} ft {ahead} it (x).",
+                     "about {abs_estimate:.2f} ± {std_error:.2f} ft {ahead} it ({component}).",
     "nonlinear_alpha": "The {axis} mismatch curves with angle of attack: the model lacks a nonlinear term, "
                        "{parameter} = {estimate:.3g} ± {std_error:.2g} {units}.",
     "coefficient_error": "The model's {parameter} is off: the data say {estimate:.4g} ± {std_error:.2g} {units}, "
@@ -283,6 +283,10 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
     parameter, estimated there by the same kinematic check, must show with the same sign and
     |t| >= :data:`SENSOR_CONFIRM_T` ('confirmed'); of the opposite sign at that |t|,
     'contradicted'; else 'neutral'."""
+    if "replication" in f.details:  # named on the two maneuvers' kinematics together
+        v, sv = f.details["replication"]["validation"]
+        return {"status": "confirmed", "axes": [], "estimate": float(v), "std_error": float(sv), "t": float(v / sv),
+                "rule": "named on both maneuvers' kinematics (analysis.name_replicated)"}
     twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
     if twin is None:
         return {"status": "neutral", "axes": [], "estimate": None, "t": None,
@@ -549,13 +553,26 @@ def _remaining(a: Analysis, fit_b: dict, fit_a: dict) -> dict:
     return out
 
 
+# Body axes: x forward, y out of the right wing, z down.
+_OFFSET_WORDS = {"x": ("ahead of", "behind"), "y": ("right of", "left of"), "z": ("below", "above")}
+
+
+def _offset_direction(parameter: str, estimate: float) -> tuple[str, str]:
+    """The body axis an accelerometer-position parameter measures along (``offset_y`` → y;
+    the force-mismatch fit's ``x_accelerometer`` → x) and the words for its sign."""
+    axis = parameter[-1] if parameter.startswith("offset_") else "x"
+    ahead, behind = _OFFSET_WORDS.get(axis, _OFFSET_WORDS["x"])
+    return axis, ahead if estimate >= 0 else behind
+
+
 def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = None) -> dict:
     fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
            "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
     if c.effect == "coefficient_error":
         fmt["model_value"] = c.estimate - c.details["change"]
         fmt["model_at_trim"] = c.details.get("model_at_trim", float("nan"))
-    fmt["abs_estimate"], fmt["ahead"] = abs(c.estimate), "ahead of" if c.estimate >= 0 else "behind"
+    fmt["abs_estimate"] = abs(c.estimate)
+    fmt["component"], fmt["ahead"] = _offset_direction(c.parameter, c.estimate)
     even = c.parameter.endswith("_beta_abs")
     fmt["product"] = "|beta|, an even function of sideslip" if even else "(alpha - alpha_trim)·beta"
     fmt["even"] = (" (or, as here, the model has one of opposite sign: a symmetric airframe's rolling and yawing "
@@ -901,6 +918,8 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     if validation is not None:
         pv, av, befores["validation"] = (pending.result() if pending is not None else
                                          _analysed(recs["validation"], "validation", aircraft))
+    if validation is not None:  # sensor errors each maneuver only suspects, named on the two
+        name_replicated(a, av)
     findings = _findings(a)
     checks: dict[int, dict | None] = {}
     unconfirmed: list[Candidate] = []

@@ -23,6 +23,7 @@ from harness.diagnosis.gallery import (GalleryCase, StructuralMode, identificati
                                        write_case)
 from harness.diagnosis.refine import validation_rms_pair
 from harness.diagnosis.run import diagnose
+from harness.noise_presets import preset
 from maneuvers.combine import Sequence, Simultaneous
 from maneuvers.multistep import MultiStep, multistep
 from models.atmosphere import Turbulence
@@ -153,13 +154,24 @@ def score(c: SweepCase, result: dict) -> dict:
     if c.expect == "none":
         row.update(a=first["effect"] == "none", b=None, c=first["effect"] == "none", d=None)
         return row
+    if c.expect == "sensor_bias" and math.isfinite(c.truth):
+        row["truth"] = recorded_bias(c)
+        row["hidden"] = c.truth
     row["a"] = first["effect"] == c.expect and first["parameter"] == c.parameter
-    row["b"] = size_right(first, c.expect, c.truth, row["a"])
+    row["b"] = size_right(first, c.expect, row["truth"] if row["truth"] is not None else c.truth, row["a"])
     row["c"] = None
     row["d"], rms = validation_drop(first, c.channel, row["a"])
     if rms is not None:
         row["validation_rms"] = rms
     return row
+
+
+def recorded_bias(c: SweepCase) -> float:
+    """The bias the recording's instrument has: the concealed one plus the ``realistic`` noise
+    layer's own constant bias on that channel (:data:`harness.noise_presets.BIASES`, e.g.
+    0.005 g on a_z), which the kinematics see just the same."""
+    layer = preset("realistic").channel_map.get(c.channel)
+    return c.truth + (layer.bias if layer is not None else 0.0)
 
 
 def size_right(first: dict, expect: str, truth: float, named: bool) -> bool | None:
