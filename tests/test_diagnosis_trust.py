@@ -322,3 +322,39 @@ def test_an_accelerometer_offset_is_explained_along_its_own_axis():
     assert _offset_direction("offset_y", -3.9) == ("y", "left of")
     assert _offset_direction("offset_z", 2.0) == ("z", "below")
     assert _offset_direction("x_accelerometer", -5.0) == ("x", "behind")
+
+
+def test_an_accelerometer_at_the_position_the_metadata_give_is_carried_to_the_cg():
+    """prepare.accelerometer_to_cg: an accelerometer r = (x, y, z) ft from the c.g. reads
+    a + [ω̇ × r + ω × (ω × r)]/g₀; with the position in the metadata the c.g. readings come
+    back, the angular accelerations from the Savitzky-Golay derivative of the rates (to the
+    window's cubic fit: sines of 0.5-1.5 Hz at 50 Hz), or the recorded pdot/qdot/rdot
+    exactly; the position moves to meta['accelerometer_at_cg'] and a second call does nothing."""
+    import numpy as np
+    import pandas as pd
+
+    from harness.diagnosis.prepare import accelerometer_to_cg
+    from maneuvers.recording import Recording
+    from models.constants import G0_FPS2
+    n, dt = 1000, 0.02
+    t = np.arange(n) * dt
+    w = [2 * np.pi * f for f in (1.5, 1.0, 0.5)]
+    p, q, r = 0.2 * np.sin(w[0] * t), 0.1 * np.cos(w[1] * t), 0.05 * np.sin(w[2] * t)
+    pd_, qd, rd = 0.2 * w[0] * np.cos(w[0] * t), -0.1 * w[1] * np.sin(w[1] * t), 0.05 * w[2] * np.cos(w[2] * t)
+    pos = np.array([10.0, 2.0, 3.0])
+    om, omd = np.stack([p, q, r], axis=1), np.stack([pd_, qd, rd], axis=1)
+    extra = (np.cross(omd, pos) + np.cross(om, np.cross(om, pos))) / G0_FPS2
+    cg = {"ax_g": 0.02 * np.sin(t), "ay_g": 0.01 * np.cos(t), "az_g": -1.0 + 0.1 * np.sin(2 * t)}
+    data = pd.DataFrame({"t_s": t, "p_rps": p, "q_rps": q, "r_rps": r,
+                         **{c: cg[c] + extra[:, i] for i, c in enumerate(("ax_g", "ay_g", "az_g"))}})
+    meta = {"sensors": {"accelerometer_ft": list(pos)}}
+    rec = accelerometer_to_cg(Recording(data=data, meta=meta, name="r"))
+    inner = slice(10, n - 10)  # the filter's ends
+    for c in cg:  # the cubic fit's gain at 1.5 Hz is 0.999: under 1e-3 g here
+        assert np.max(np.abs(rec.data[c].to_numpy()[inner] - cg[c][inner])) < 1e-3
+    assert rec.meta["accelerometer_at_cg"] == list(pos) and rec.meta["sensors"]["accelerometer_ft"] == [0.0] * 3
+    assert accelerometer_to_cg(rec) is rec
+    measured = data.assign(pdot_rps2=pd_, qdot_rps2=qd, rdot_rps2=rd)
+    exact = accelerometer_to_cg(Recording(data=measured, meta=meta, name="r"))
+    for c in cg:
+        assert np.allclose(exact.data[c], cg[c], atol=1e-12)

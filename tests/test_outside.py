@@ -299,3 +299,27 @@ def test_other_conventions_read_back_as_written(tmp_path):
         maneuvers("pitch", CONDITIONS["S"], "chirp")
     assert Convention().describe() == ""
     assert Convention(rate_hz=25.0, units="deg-kts").describe() == "25 Hz, deg-kts"
+
+
+def test_an_accelerometer_away_from_the_cg_and_declared_comes_back_to_it():
+    """outside.accelerometer_away (the sweep's declared-accelerometer convention) moves a
+    flight's readings to a position with the flight's own angular accelerations;
+    prepare.accelerometer_to_cg, given the position, brings them back exactly when the
+    recording keeps pdot/qdot/rdot."""
+    import numpy as np
+    import pandas as pd
+
+    from harness.diagnosis.outside import Convention, accelerometer_away
+    from harness.diagnosis.prepare import accelerometer_to_cg
+    from maneuvers.recording import Recording
+    t = np.arange(200) * 0.02
+    d = pd.DataFrame({"t_s": t, "p_rps": 0.1 * np.sin(3 * t), "q_rps": 0.05 * np.cos(2 * t), "r_rps": 0.02 * t,
+                      "pdot_rps2": 0.3 * np.cos(3 * t), "qdot_rps2": -0.1 * np.sin(2 * t), "rdot_rps2": 0.02 + 0 * t,
+                      "ax_g": 0.01 + 0 * t, "ay_g": 0 * t, "az_g": -1.0 + 0 * t})
+    pos = (10.0, 2.0, 3.0)
+    away = accelerometer_away(Recording(data=d, meta={}, name="f"), pos)
+    assert np.ptp(away.data["az_g"]) > 0.01  # 10 ft of q̇ and ω×(ω×r) moved it
+    back = accelerometer_to_cg(Recording(data=away.data, meta={"sensors": {"accelerometer_ft": list(pos)}}, name="f"))
+    for c in ("ax_g", "ay_g", "az_g"):
+        assert np.allclose(back.data[c], d[c], atol=1e-13)
+    assert Convention(accelerometer_ft=pos).describe() == "accelerometer x10 y2 z3 ft"

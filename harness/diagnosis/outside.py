@@ -57,7 +57,7 @@ from maneuvers.recording import Recording
 from models.aircraft import Aircraft
 from models.atmosphere import Turbulence
 from models.flight import Loop
-from models.hidden import HiddenEffect as H, vane_shift
+from models.hidden import HiddenEffect as H, offset_accelerometer, vane_shift
 
 DEG = math.pi / 180.0
 EARTH_RATE_RPS = 7.292115e-5  # WGS-84, as JSBSim
@@ -301,6 +301,7 @@ class Convention:
     duration_s: float = DURATION_S
     units: str = "canonical"       # or 'deg-kts': angles in deg, rates in deg/s, V in kts, h in m
     vanes_ft: float = 0.0          # both vanes this far ahead of the c.g., the position in the metadata
+    accelerometer_ft: tuple[float, float, float] = (0.0, 0.0, 0.0)  # its position, in the metadata too
 
     def describe(self) -> str:
         """The departures from the usual recording, '' for none."""
@@ -309,7 +310,8 @@ class Convention:
                  "gauss_markov_deg": lambda v: f"vane wander {v:g} deg",
                  "actuator_rps": lambda v: f"actuator {v:g} rad/s",
                  "duration_s": lambda v: f"{v:g} s", "units": lambda v: v,
-                 "vanes_ft": lambda v: f"vanes {v:g} ft ahead"}
+                 "vanes_ft": lambda v: f"vanes {v:g} ft ahead",
+                 "accelerometer_ft": lambda v: "accelerometer " + " ".join(f"{a}{x:g}" for a, x in zip("xyz", v)) + " ft"}
         return ", ".join(words[k](getattr(self, k)) for k in words if getattr(self, k) != getattr(base, k))
 
 
@@ -498,6 +500,11 @@ def _convention_cases() -> list[OutsideCase]:
         ("M", "lateral", Convention(vanes_ft=15.0), None),
         ("S", "pitch", Convention(vanes_ft=15.0),
          (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
+        ("S", "three_axis", Convention(accelerometer_ft=(10.0, 2.0, 3.0)), None),
+        ("L", "lateral", Convention(accelerometer_ft=(10.0, 2.0, 3.0)), None),
+        ("C1", "three_axis", Convention(accelerometer_ft=(4.0, 1.0, 2.0)), None),
+        ("M", "pitch", Convention(accelerometer_ft=(10.0, 2.0, 3.0)),
+         (H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q")),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):
@@ -575,12 +582,18 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
         flight = fly_maneuver(spec)
         if cv.vanes_ft:
             flight = vanes_ahead(flight, cv.vanes_ft)
+        if any(cv.accelerometer_ft):
+            flight = accelerometer_away(flight, cv.accelerometer_ft)
         rec, answer = postprocess(flight, noise=not c.clean, seed=1000 * c.seed + i, drop=c.drop,
                                   mode=c.mode, aircraft_label=label, noise_model=noise)
         if cv.vanes_ft:  # the team knows where its nose boom is
             pos = [cv.vanes_ft, 0.0, 0.0]
             rec = Recording(data=rec.data, meta={**rec.meta, "sensors": {**(rec.meta.get("sensors") or {}),
                                                                          "alpha_vane_ft": pos, "beta_vane_ft": pos}},
+                            name=rec.name)
+        if any(cv.accelerometer_ft):  # and where its accelerometer is
+            rec = Recording(data=rec.data, meta={**rec.meta, "sensors": {**(rec.meta.get("sensors") or {}),
+                                                                         "accelerometer_ft": list(cv.accelerometer_ft)}},
                             name=rec.name)
         paths[role] = write_recording(rec, out_dir / f"{c.name}-{role}.csv")
         if cv.units != "canonical":  # the writer writes canonical units only; the reader takes these
@@ -609,6 +622,17 @@ def vanes_ahead(rec: Recording, x_ft: float) -> Recording:
     da, db = vane_shift(*(d[c].to_numpy(dtype=float) for c in ("p_rps", "q_rps", "r_rps", "V_fps")), (x_ft, 0.0, 0.0))
     d["alpha_rad"] = d["alpha_rad"].to_numpy(dtype=float) + da
     d["beta_rad"] = d["beta_rad"].to_numpy(dtype=float) + db
+    return Recording(data=d, meta=rec.meta, name=rec.name)
+
+
+def accelerometer_away(rec: Recording, position_ft: tuple[float, float, float]) -> Recording:
+    """A flight's accelerometers as read at ``position_ft`` from the c.g.
+    (:func:`models.hidden.offset_accelerometer`, with the flight's own angular accelerations)."""
+    d = rec.data.copy()
+    channels = {c: d[c].to_numpy(dtype=float) for c in d.columns}
+    offset_accelerometer(channels, position_ft)
+    for c in ("ax_g", "ay_g", "az_g"):
+        d[c] = channels[c]
     return Recording(data=d, meta=rec.meta, name=rec.name)
 
 

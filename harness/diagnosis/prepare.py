@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.signal import savgol_filter
 
 from estimators.coefficients import accelerometer_at_cg, force_coefficients, moment_coefficients
 from estimators.smoothing import optimal_fourier_smoother, sine_series_derivative, sine_series_filter
@@ -137,6 +138,57 @@ def vanes_at_cg(rec: Recording) -> Recording:
     return Recording(data=d, meta=meta, name=rec.name)
 
 
+# The Savitzky-Golay window (s, cubic) of the angular accelerations that carry a declared
+# accelerometer position to the c.g. when the recording has no pdot/qdot/rdot: at 50 Hz its
+# derivative's gain is 0.994 at 2 Hz and 0.97 at 3 Hz (a quadratic's 0.82 and 0.64), and it
+# turns the rate gyros' white noise (0.14 deg/s) into 0.009 g at 10 ft, a third of the
+# accelerometers' own, high in frequency where the common filter takes it out.
+ACCEL_DERIVATIVE_WINDOW_S = 0.2
+
+
+def angular_accelerations(rec: Recording) -> list[np.ndarray]:
+    """ṗ, q̇, ṙ (rad/s²): the recorded pdot/qdot/rdot when present, else a cubic
+    Savitzky-Golay derivative of the rates over :data:`ACCEL_DERIVATIVE_WINDOW_S`."""
+    d = rec.data
+    if all(f"{c}dot_rps2" in d.columns for c in "pqr"):
+        return [d[f"{c}dot_rps2"].to_numpy(dtype=float) for c in "pqr"]
+    t = d["t_s"].to_numpy(dtype=float)
+    dt = float(np.median(np.diff(t)))
+    n = min(max(5, 2 * int(round(0.5 * ACCEL_DERIVATIVE_WINDOW_S / dt)) + 1), t.size - (1 - t.size % 2))
+    return [savgol_filter(d[f"{c}_rps"].to_numpy(dtype=float), n, 3, deriv=1, delta=dt) for c in "pqr"]
+
+
+def accelerometer_to_cg(rec: Recording) -> Recording:
+    """``rec`` with its accelerometers carried to the c.g. from the position its metadata give
+    (``sensors.accelerometer_ft``; unchanged at [0, 0, 0] or when done already):
+    a_cg = a − [ω̇ × r + ω × (ω × r)]/g₀ (:func:`estimators.coefficients.accelerometer_at_cg`).
+    The position moves to ``meta['accelerometer_at_cg']`` and ``sensors`` holds it at zero,
+    so that every test (the kinematics, the coefficients, the replays' outputs) sees c.g.
+    readings. Measured on an F-16 pitch recording with the accelerometer 10 ft ahead and the
+    position declared: taken as read, the kinematics asked for an offset of 12 ± 3 ft (t 4.3)
+    and leaned a_z's scale and α's skew with it."""
+    sensors = dict(rec.meta.get("sensors") or {})
+    pos = [float(v) for v in sensors.get("accelerometer_ft") or (0.0, 0.0, 0.0)]
+    if not any(pos):
+        return rec
+    d = rec.data.copy()
+    rates = [d[f"{c}_rps"].to_numpy(dtype=float) for c in "pqr"]
+    moved = accelerometer_at_cg(*(d[f"a{c}_g"].to_numpy(dtype=float) for c in "xyz"), *rates,
+                                *angular_accelerations(rec), pos)
+    for c, col in zip("xyz", moved):
+        d[f"a{c}_g"] = col
+    meta = dict(rec.meta)
+    meta["accelerometer_at_cg"] = pos
+    meta["sensors"] = {**sensors, "accelerometer_ft": [0.0, 0.0, 0.0]}
+    return Recording(data=d, meta=meta, name=rec.name)
+
+
+def instruments_at_cg(rec: Recording) -> Recording:
+    """``rec`` with its vanes (:func:`vanes_at_cg`) and accelerometers
+    (:func:`accelerometer_to_cg`) carried to the c.g. from the positions its metadata give."""
+    return accelerometer_to_cg(vanes_at_cg(rec))
+
+
 def _channels(rec: Recording) -> dict[str, np.ndarray]:
     out = {}
     for q, unit in UNITS.items():
@@ -184,7 +236,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     ValueError
         When the recording is too short (under 4 s) or lacks what Eqs. 1-5 need.
     """
-    rec = vanes_at_cg(rec)
+    rec = instruments_at_cg(rec)
     raw = _channels(rec)
     t = rec.data["t_s"].to_numpy(dtype=float)
     t = t - t[0]
@@ -242,7 +294,14 @@ def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...])
         out.append({"item": "mass and inertia", "missing": "mass channels",
                     "stood_in_by": "the metadata's constants, for the whole maneuver"})
     sensors = meta.get("sensors") or {}
-    if "accelerometer_ft" not in sensors:
+    if meta.get("accelerometer_at_cg"):
+        out.append({"item": "accelerometer position", "missing": "-",
+                    "stood_in_by": f"carried to the c.g. from the metadata's position {meta['accelerometer_at_cg']} "
+                                   "ft with the recorded rates (a − ω̇ × r − ω × (ω × r); ω̇ "
+                                   + ("recorded)" if all(f"{c}dot_rps2" in columns for c in "pqr") else
+                                      f"from a {ACCEL_DERIVATIVE_WINDOW_S:g} s Savitzky-Golay derivative of the "
+                                      "rates)")})
+    elif "accelerometer_ft" not in sensors:
         out.append({"item": "accelerometer position", "missing": "sensors.accelerometer_ft",
                     "stood_in_by": "at the c.g. (any offset is then a finding, sensor_offset)"})
     moved = meta.get("vanes_at_cg") or {}

@@ -18,7 +18,7 @@ from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
 from harness.diagnosis.analysis import Analysis, Candidate, analyse, name_replicated
 from harness.diagnosis.fits import coefficient_fit, output_fit
-from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, vanes_at_cg
+from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, instruments_at_cg
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
 from harness.executors import LocalPool
 from harness.recording_io import read_recording
@@ -899,14 +899,14 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
               calibrate: bool = True, workers: int = 2, pool: LocalPool | None = None) -> dict:
     t0 = time.perf_counter()
     aircraft = _aircraft(model)
-    rec = vanes_at_cg(read_recording(recording))
+    rec = instruments_at_cg(read_recording(recording))
     if mass == "recording":
         aircraft = _with_recorded_mass(aircraft, rec)
     elif mass != "model":
         raise DiagnosisError(f"mass must be 'model' or 'recording', not {mass!r}")
     recs = {"identification": rec}
     if validation is not None:
-        recs["validation"] = vanes_at_cg(read_recording(validation))
+        recs["validation"] = instruments_at_cg(read_recording(validation))
     pending = None
     if validation is not None and pool is not None:
         pending = pool.pool.submit(_analysed, recs["validation"], "validation", aircraft)
