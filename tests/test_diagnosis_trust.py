@@ -358,3 +358,17 @@ def test_an_accelerometer_at_the_position_the_metadata_give_is_carried_to_the_cg
     exact = accelerometer_to_cg(Recording(data=measured, meta=meta, name="r"))
     for c in cg:
         assert np.allclose(exact.data[c], cg[c], atol=1e-12)
+
+
+def test_surfaces_not_recorded_are_named_with_what_stood_in_for_them():
+    """prepare._stand_ins: recording-format.md requires only the surfaces that moved; those
+    left out are held at the model's trim deflection, and the assumptions say so."""
+    import numpy as np
+
+    from harness.diagnosis.prepare import _stand_ins
+    raw = {c: np.zeros(3) for c in ("de", "thrust")}
+    found = {a["item"]: a for a in _stand_ins(raw, {"sensors": {"accelerometer_ft": [0, 0, 0]}}, ())}
+    assert found["surfaces not recorded"]["missing"] == "da, dr"
+    assert "trim deflection" in found["surfaces not recorded"]["stood_in_by"]
+    everything = {c: np.zeros(3) for c in ("de", "da", "dr", "thrust")}
+    assert "surfaces not recorded" not in {a["item"] for a in _stand_ins(everything, {}, ())}

@@ -926,15 +926,16 @@ def _name_if_corroborated(sensor: Candidate, kin: KinematicResult, p: Prepared, 
 
 
 # The |t| each maneuver's kinematic estimate must reach on its own for a sensor error below
-# the kinematic entry t to be named on the two together (:func:`name_replicated`): the
-# suspicion level of the other sensor rules (:data:`AMBIGUOUS_T`).
+# the identification's entry t to be named on the two together (:func:`name_replicated`):
+# the suspicion level of the other sensor rules (:data:`AMBIGUOUS_T`).
 REPLICATED_EACH_T = AMBIGUOUS_T
 
 
 def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
-    """Name the sensor errors that the identification and the validation maneuvers each
-    suspect (kinematic |t| >= :data:`REPLICATED_EACH_T`, below the entry t) with the same
-    sign and sizes within two standard errors, when their inverse-variance combination
+    """Name the sensor errors that the identification's kinematics only suspect (|t| at least
+    :data:`REPLICATED_EACH_T`, below the entry t) and the validation's show too (|t| at least
+    as much, the same sign, sizes within two standard errors), when their inverse-variance
+    combination
     reaches the kinematic entry t (:data:`kinematics.T_IN`): the same instrument flew both,
     and their kinematic residuals carry independent noise. Not when either record's
     kinematics are void (turbulence, light gusts, implausible estimates), when the
@@ -974,8 +975,9 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
             continue
         c.details["replication"] = {"identification": [c.estimate, c.std_error],
                                     "validation": [v.estimate, v.std_error], "combined": [est, se]}
-        c.reason = (f"named on two maneuvers: the identification's kinematics (t = {c.t:.1f}) and the "
-                    f"validation's (t = {v.t:.1f}) agree on it, each below the entry t {KIN_T_IN:g} alone")
+        c.reason = (f"named on two maneuvers: the identification's kinematics suspect it (t = {c.t:.1f}, below "
+                    f"the entry t) and the validation's agree (t = {v.t:.1f}, the sizes within two standard "
+                    f"errors); together t = {est / se:.1f}")
         c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
         named.append(c)
     return named

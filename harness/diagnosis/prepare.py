@@ -290,6 +290,11 @@ def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...])
                                     "(recording-format: constant at trim)" if trim_thrust is not None else
                                     "constant at the model's trim thrust at the recording's start "
                                     "(recording-format: constant at trim; the metadata give none)")})
+    absent = [s for s in SURFACES if s not in raw]
+    if absent:
+        out.append({"item": "surfaces not recorded", "missing": ", ".join(absent),
+                    "stood_in_by": "held at the model's trim deflection throughout (recording-format: only the "
+                                   "surfaces that moved are required); a term on them cannot be tested"})
     if "mass_slug" not in columns:
         out.append({"item": "mass and inertia", "missing": "mass channels",
                     "stood_in_by": "the metadata's constants, for the whole maneuver"})
