@@ -125,6 +125,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         _withhold_vane_scale(cands, kin, step, signature, inertial_beta(p))
         if plausible and not gusty:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
+            _name_beta_bias_from_means(cands, kin, p, aircraft, ic, step, sensor_values.get("bias_beta", 0.0))
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
     # 6. spectra and gusts
@@ -264,10 +265,11 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None,
     a vane's slow wander survives any smoother and reaches the mismatch through C_n,β, C_l,β
     and C_Y,β, where it buried the outside sweep's lateral coefficient errors (C_l,β −0.02,
     C_n,β +0.03, C_n,r̂ −0.3, C_l,p̂ −0.1 at |t| 1.6–4.7; 5.9–22 along the inertial β). A β-vane
-    scale then leaves the mismatch alone; the kinematic check names it."""
+    scale then leaves the mismatch alone; the kinematic check names it. With ``vane_beta``
+    the sideslip is the vane's own smoothed record, driven or not (the β-vane tests)."""
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
     for k in ("alpha", "beta", "p", "q", "r"):
-        if k in states and k not in p.driven and k not in p.moved:
+        if k in states and k not in p.driven and k not in p.moved and not (k == "beta" and vane_beta):
             states[k] = np.full(p.n, p.start[k])
     if inertial_beta(p) and not vane_beta:
         src = inertial_from or p
@@ -662,7 +664,7 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
         """The mismatch along the β vane (made when first asked)."""
         return model_along(p, aircraft, ic, vane_beta=True).mismatch()
 
-    def ratios(name: str, value: float, skip: frozenset[str] = frozenset()) -> dict:
+    def ratios(name: str, value: float, skip: frozenset[str] = frozenset(), constant: bool = True) -> dict:
         # the inertial sideslip stays the one integrated from p: it is built from the same
         # instruments as the kinematic check, so letting it follow the correction would make
         # the two tests one
@@ -670,22 +672,23 @@ def _signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared,
             # a β-vane error cannot reach a mismatch along the inertial sideslip: its signature
             # is taken along the vane (whose slow wander the colored-residual fit allows for)
             changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, vane_beta=True).mismatch()
-            return _axis_ratios(cands, step, inner, along_vane(), changed, skip)
+            return _axis_ratios(cands, step, inner, along_vane(), changed, skip, constant)
         changed = model_along(_corrected(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
-        return _axis_ratios(cands, step, inner, mismatch, changed, skip)
+        return _axis_ratios(cands, step, inner, mismatch, changed, skip, constant)
     return ratios
 
 
 def _axis_ratios(cands: list[Candidate], step: _Stepwise, inner: slice, base: dict[str, np.ndarray],
-                 changed: dict[str, np.ndarray], skip: frozenset[str] = frozenset()) -> dict:
+                 changed: dict[str, np.ndarray], skip: frozenset[str] = frozenset(), constant: bool = True) -> dict:
     """Per axis, :func:`corroborate.axis_ratio` of ``base`` on the change ``changed - base``,
-    beside the axis's named terms (those in ``skip`` left out) and its nuisance columns."""
+    beside the axis's named terms (those in ``skip`` left out) and its nuisance columns (with
+    a constant unless not ``constant``)."""
     out = {}
     for axis, (sel, by_key) in step.selections.items():
         kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
         others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
         others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
-        r = corroborate.axis_ratio(base[axis][inner], others, (changed[axis] - base[axis])[inner])
+        r = corroborate.axis_ratio(base[axis][inner], others, (changed[axis] - base[axis])[inner], constant)
         if r is not None:
             out[axis] = r
     return out
@@ -751,6 +754,56 @@ def _kinematics_refute(kin: KinematicResult, name: str, k: float, k_std: float) 
         return ""
     return (f"an {name.split('_', 1)[1]} vane scale of k = {k:.3f} ± {k_std:.3f} would imitate it, but the "
             f"kinematics put that scale at {v:.3f} ± {se:.3f} ({z:.1f} standard errors apart)")
+
+
+# The β-vane bias (rad) at which its signature on the lateral means is evaluated (the fit
+# scales it).
+PROBE_BETA_BIAS = np.radians(0.5)
+BETA_BIAS_TEST = "lateral coefficient means along the β vane"
+
+
+def _name_beta_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                               ic: InitialCondition, step: _Stepwise, applied: float = 0.0) -> None:
+    """Name a β-vane bias from the lateral coefficients' means along the vane.
+
+    The kinematics all but miss a β bias (β enters them through cos β: a 1° bias stood at
+    t 1.3-1.5), and the stepwise fits' constants absorb what it does to the coefficients.
+    But the model evaluated along a vane that reads β + b is off by each lateral
+    coefficient's own sideslip slope times b, a constant on C_Y, C_l and C_n in the model's
+    proportions. So each lateral axis's mismatch along the vane is fitted on the change a
+    probe bias makes (:data:`PROBE_BETA_BIAS`), without a constant (beside the axis's named
+    terms), along the vane's own record whether or not the maneuver moved β (held at its
+    start sample, the test would measure that sample's noise); a kinematic estimate already
+    applied to the channels (``applied``) is added back. The bias is named when the
+    axes that can tell agree on it, significantly
+    (:func:`corroborate.imitates`), and it is practical and precise (:func:`_sensor_verdict`).
+    A constant model error on one axis (an asymmetry, a propeller's torque) does not match
+    the sideslip slopes' proportions on all three. The estimate is kept in
+    ``details['lateral_means']`` whether named or not, for the validation maneuver's check."""
+    c = next((c for c in cands if c.parameter == "bias_beta"), None)
+    if c is None or c.selected or "bias_beta" not in kin.parameters:
+        return
+    base = model_along(p, aircraft, ic, vane_beta=True).mismatch()
+    changed = model_along(_corrected(p, kin, {"bias_beta": PROBE_BETA_BIAS}), aircraft, ic, vane_beta=True).mismatch()
+    ratios = {k: r for k, r in _axis_ratios(cands, step, _inner(p), base, changed, constant=False).items()
+              if k in cand.LAT}
+    ag = corroborate.imitates(ratios, t_aero=cand.T_IN)
+    if ag is None:
+        return
+    # the channels were corrected by the kinematic estimate already applied: the means see the rest
+    est, se = applied + ag.ratio * PROBE_BETA_BIAS, ag.std_error * PROBE_BETA_BIAS
+    c.details["lateral_means"] = {"estimate": est, "std_error": se, "applied_before": applied,
+                                  "axes": {a.axis: [a.ratio * PROBE_BETA_BIAS, a.std_error * PROBE_BETA_BIAS]
+                                           for a in ag.axes}}
+    sel, _ = _sensor_verdict("bias_beta", est, se, True, kin, p, False, True)
+    if not sel:
+        return
+    each = ", ".join(f"{a.axis} {np.degrees(a.ratio * PROBE_BETA_BIAS):.2f}° ± "
+                     f"{np.degrees(a.std_error * PROBE_BETA_BIAS):.2f}°" for a in ag.axes)
+    c.reason = (f"the model along the β vane is off by its own sideslip slopes times one constant on every lateral "
+                f"axis that can tell ({each}); the kinematics hardly see a β bias (there t = {c.t:.1f})")
+    c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
+    c.test = BETA_BIAS_TEST
 
 
 def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature, applied: set[str],

@@ -74,13 +74,16 @@ class Corroboration:
                 "named": self.named, "reason": self.reason}
 
 
-def axis_ratio(z: np.ndarray, others: list[np.ndarray], signature: np.ndarray) -> AxisRatio | None:
+def axis_ratio(z: np.ndarray, others: list[np.ndarray], signature: np.ndarray,
+               constant: bool = True) -> AxisRatio | None:
     """``a ± σ`` of ``z ≈ others·θ - a·signature + c`` (colored-residual standard error);
-    None when the signature is flat or dependent on the others."""
-    if np.ptp(signature) <= 0:
+    without ``c`` when not ``constant`` (a bias's signature is nearly a constant). None when
+    the signature is flat (or, with the constant, dependent on the others)."""
+    if np.ptp(signature) <= 0 if constant else not np.any(signature):
         return None
     try:
-        theta, se, _ = colored_fit(z, others + [-signature], [f"o{i}" for i in range(len(others))] + ["a"])
+        theta, se, _ = colored_fit(z, others + [-signature], [f"o{i}" for i in range(len(others))] + ["a"],
+                                   constant=constant)
     except (SingularRegressorsError, np.linalg.LinAlgError):
         return None
     j = len(others)

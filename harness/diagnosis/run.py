@@ -16,7 +16,7 @@ from scipy import signal
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
-from harness.diagnosis.analysis import Analysis, Candidate, analyse, name_replicated
+from harness.diagnosis.analysis import BETA_BIAS_TEST, Analysis, Candidate, analyse, name_replicated
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, instruments_at_cg
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
@@ -191,6 +191,8 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     ``status`` is 'confirmed' (the mismatch RMS, summed over its axes in units of each axis's
     noise level, drops by 1 % or more), 'contradicted' (it rises by 1 % or more) or 'neutral'; None for a finding with no coefficient term (a
     sensor effect, a gust level, a spectral peak)."""
+    if f.test == BETA_BIAS_TEST:
+        return _lateral_means_check(av, f)
     if f.test.startswith("kinematic consistency") or f.parameter == "x_accelerometer":
         return _sensor_check(av, f)
     after, n_terms = _after_mismatch(av, [f])
@@ -306,6 +308,25 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
                     f"{CORROBORATED_CONFIRM_T:g} and within two standard errors of the identification's kinematic "
                     f"estimate ({kin['kinematic']:.4g} ± {kin['kinematic_std']:.2g})"}
     return out
+
+
+def _lateral_means_check(av: Analysis, f: Candidate) -> dict:
+    """A β-vane bias named on the lateral coefficient means
+    (:func:`analysis._name_beta_bias_from_means`), tested the same way on the validation
+    maneuver: the same vane, so the same sign at |t| >= :data:`SENSOR_CONFIRM_T` there
+    ('confirmed'), the opposite sign at that |t| ('contradicted'), else 'neutral'."""
+    twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
+    means = (twin.details.get("lateral_means") if twin is not None else None) or {}
+    if not means:
+        return {"status": "neutral", "axes": [], "estimate": None, "t": None,
+                "reason": "the validation maneuver's lateral means cannot tell a β bias"}
+    v, sv = means["estimate"], means["std_error"]
+    t = v / sv if sv > 0 else 0.0
+    same = np.sign(v) == np.sign(f.estimate)
+    status = ("confirmed" if same and abs(t) >= SENSOR_CONFIRM_T else
+              "contradicted" if not same and abs(t) >= SENSOR_CONFIRM_T else "neutral")
+    return {"status": status, "axes": list(means["axes"]), "estimate": float(v), "std_error": float(sv),
+            "t": float(t)}
 
 
 def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
@@ -585,9 +606,12 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
     if check is not None:
         evidence["validation"] = check
-        if check["status"] == "contradicted":
+        if check["status"] == "contradicted" and "change" in check:
             text += (f" The validation maneuver contradicts it (its {', '.join(check['axes'])} mismatch grows by "
                      f"{100 * check['change']:.0f} % with the term), so it is not in the augmented model.")
+        elif check["status"] == "contradicted":  # a sensor test: the same test there says the opposite
+            text += (f" The validation maneuver contradicts it (the same test there gives {check['estimate']:.4g} ± "
+                     f"{check['std_error']:.2g} {c.units}, t = {check['t']:.1f}), so it is not in the augmented model.")
     return {"effect": c.effect, "axis": c.axis if c.axis in ("pitch", "roll", "yaw", "lon", "lat") else None,
             "channel": c.channel, "parameter": c.parameter, "estimate": float(c.estimate),
             "std_error": float(c.std_error), "units": c.units, "evidence": evidence,
