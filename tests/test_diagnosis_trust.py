@@ -375,7 +375,7 @@ def test_surfaces_not_recorded_are_named_with_what_stood_in_for_them():
 
 
 def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
-    """analysis._name_beta_bias_from_means on the project sweep's β-vane bias of 1° (1.05° in
+    """analysis._name_vane_bias_from_means on the project sweep's β-vane bias of 1° (1.05° in
     the recording with the noise layer's own 0.05°): the kinematics hardly see it (t 1.5),
     the lateral means along the vane do, on C_Y, C_l and C_n alike; the validation maneuver
     (pitch only, β never driven) shows the same bias on its own means, and the augmented
@@ -389,7 +389,7 @@ def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
     result = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
     f = result["findings"][0]
     assert f["evidence"]["test"] == "lateral coefficient means along the β vane"
-    assert set(f["evidence"]["lateral_means"]["axes"]) == {"CY", "Cl", "Cn"}
+    assert set(f["evidence"]["vane_means"]["axes"]) == {"CY", "Cl", "Cn"}
     assert abs(f["estimate"] - recorded_bias(c)) <= max(2 * f["std_error"], 0.02 * recorded_bias(c))
     assert f["evidence"]["validation"]["status"] == "confirmed"
     assert math.degrees(recorded_bias(c)) == pytest.approx(1.05)

@@ -125,7 +125,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         _withhold_vane_scale(cands, kin, step, signature, inertial_beta(p))
         if plausible and not gusty:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
-            _name_beta_bias_from_means(cands, kin, p, aircraft, ic, step, sensor_values.get("bias_beta", 0.0))
+            for vane in VANE_MEANS_AXES:
+                _name_vane_bias_from_means(cands, kin, p, aircraft, ic, step, vane, sensor_values.get(f"bias_{vane}", 0.0))
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
     # 6. spectra and gusts
@@ -246,8 +247,8 @@ def _corrected(p: Prepared, kin: KinematicResult, values: dict[str, float]) -> P
     return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
 
 
-def model_states(p: Prepared, inertial_from: Prepared | None = None,
-                 vane_beta: bool = False) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: bool = False,
+                 vanes: bool = False) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """The states and surfaces the model is evaluated along.
 
     A state the maneuver did not drive is held at its start: evaluated along its noise, the
@@ -266,12 +267,13 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None,
     and C_Y,β, where it buried the outside sweep's lateral coefficient errors (C_l,β −0.02,
     C_n,β +0.03, C_n,r̂ −0.3, C_l,p̂ −0.1 at |t| 1.6–4.7; 5.9–22 along the inertial β). A β-vane
     scale then leaves the mismatch alone; the kinematic check names it. With ``vane_beta``
-    the sideslip is the vane's own smoothed record, driven or not (the β-vane tests)."""
+    the sideslip is the vane's; with ``vanes`` α and β are both the vanes' own smoothed
+    records, driven or not (the vane-bias tests on the coefficient means)."""
     states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
     for k in ("alpha", "beta", "p", "q", "r"):
-        if k in states and k not in p.driven and k not in p.moved and not (k == "beta" and vane_beta):
+        if k in states and k not in p.driven and k not in p.moved and not (vanes and k in ("alpha", "beta")):
             states[k] = np.full(p.n, p.start[k])
-    if inertial_beta(p) and not vane_beta:
+    if inertial_beta(p) and not (vane_beta or vanes):
         src = inertial_from or p
         states["beta"] = inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)["beta"]
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
@@ -296,11 +298,11 @@ class ModelAlong(NamedTuple):
 
 
 def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
-                inertial_from: Prepared | None = None, vane_beta: bool = False) -> ModelAlong:
+                inertial_from: Prepared | None = None, vane_beta: bool = False, vanes: bool = False) -> ModelAlong:
     """The measured coefficients and the model's along the states of :func:`model_states`
     (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
-    sideslip with ``vane_beta``)."""
-    states, surfaces = model_states(p, inertial_from, vane_beta)
+    sideslip with ``vane_beta``; both vanes' own records with ``vanes``)."""
+    states, surfaces = model_states(p, inertial_from, vane_beta, vanes)
     alphadot = p.deriv["alpha"] if "alpha" in p.driven or "alpha" in p.moved else None
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
@@ -756,54 +758,65 @@ def _kinematics_refute(kin: KinematicResult, name: str, k: float, k_std: float) 
             f"kinematics put that scale at {v:.3f} ± {se:.3f} ({z:.1f} standard errors apart)")
 
 
-# The β-vane bias (rad) at which its signature on the lateral means is evaluated (the fit
+# The vane bias (rad) at which its signature on the coefficient means is evaluated (the fit
 # scales it).
-PROBE_BETA_BIAS = np.radians(0.5)
-BETA_BIAS_TEST = "lateral coefficient means along the β vane"
+PROBE_VANE_BIAS = np.radians(0.5)
+# Per vane: the axes its bias reaches through the model's slopes, and the test's name. The β
+# vane only: on the force axes the means carry errors of the thrust's direction and level and
+# of the mass, which an α bias's C_X and C_Z proportions can match. Offered for α too, the test
+# named a 1° α bias on the c172x at 180 ft/s (1.036 ± 0.005°; the kinematics t 1.4) but also
+# an α bias of −1.87° on the 737's noise-free self-check, from C_X and C_Z alone (its engines'
+# thrust is not along body x); on 82 null and self-check recordings the β test agreed on no
+# bias above 0.066° (practical: 0.15°).
+VANE_MEANS_AXES = {"beta": cand.LAT}
+MEANS_TESTS = {"beta": "lateral coefficient means along the β vane"}
 
 
-def _name_beta_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
-                               ic: InitialCondition, step: _Stepwise, applied: float = 0.0) -> None:
-    """Name a β-vane bias from the lateral coefficients' means along the vane.
+def _name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                               ic: InitialCondition, step: _Stepwise, channel: str, applied: float = 0.0) -> None:
+    """Name a vane bias (``channel``; :data:`VANE_MEANS_AXES`) from the coefficients' means
+    along the vane.
 
-    The kinematics all but miss a β bias (β enters them through cos β: a 1° bias stood at
-    t 1.3-1.5), and the stepwise fits' constants absorb what it does to the coefficients.
-    But the model evaluated along a vane that reads β + b is off by each lateral
-    coefficient's own sideslip slope times b, a constant on C_Y, C_l and C_n in the model's
-    proportions. So each lateral axis's mismatch along the vane is fitted on the change a
-    probe bias makes (:data:`PROBE_BETA_BIAS`), without a constant (beside the axis's named
-    terms), along the vane's own record whether or not the maneuver moved β (held at its
-    start sample, the test would measure that sample's noise); a kinematic estimate already
-    applied to the channels (``applied``) is added back. The bias is named when the
-    axes that can tell agree on it, significantly
+    The kinematics can all but miss a vane bias (β enters them through cos β: a 1° bias stood
+    at t 1.3-1.5; a c172x's 1° α bias at 180 ft/s at t 1.4), and the stepwise fits' constants
+    absorb what it does to the coefficients. But the model evaluated along a vane that reads
+    x + b is off by each coefficient's own slope in x times b: one constant on C_Y, C_l and
+    C_n (β) or C_X, C_Z and C_m (α) in the model's proportions. So each such axis's mismatch
+    is fitted on the change a probe bias makes (:data:`PROBE_VANE_BIAS`), without a constant
+    (beside the axis's named terms and nuisances), along the vanes' own records whether or not
+    the maneuver moved them (held at a start sample, the test would measure that sample's
+    noise); a kinematic estimate already applied to the channels (``applied``) is added
+    back. The bias is named when the axes that can tell agree on it, significantly
     (:func:`corroborate.imitates`), and it is practical and precise (:func:`_sensor_verdict`).
-    A constant model error on one axis (an asymmetry, a propeller's torque) does not match
-    the sideslip slopes' proportions on all three. The estimate is kept in
-    ``details['lateral_means']`` whether named or not, for the validation maneuver's check."""
-    c = next((c for c in cands if c.parameter == "bias_beta"), None)
-    if c is None or c.selected or "bias_beta" not in kin.parameters:
+    A constant model error on one axis (an asymmetry, a propeller's torque, a thrust or mass
+    error, a moment-reference shift) does not match the slopes' proportions on all of them.
+    The estimate is kept in ``details['vane_means']`` whether named or not, for the
+    validation maneuver's check."""
+    name = f"bias_{channel}"
+    c = next((c for c in cands if c.parameter == name), None)
+    if c is None or c.selected or name not in kin.parameters:
         return
-    base = model_along(p, aircraft, ic, vane_beta=True).mismatch()
-    changed = model_along(_corrected(p, kin, {"bias_beta": PROBE_BETA_BIAS}), aircraft, ic, vane_beta=True).mismatch()
+    base = model_along(p, aircraft, ic, vanes=True).mismatch()
+    changed = model_along(_corrected(p, kin, {name: PROBE_VANE_BIAS}), aircraft, ic, vanes=True).mismatch()
     ratios = {k: r for k, r in _axis_ratios(cands, step, _inner(p), base, changed, constant=False).items()
-              if k in cand.LAT}
+              if k in VANE_MEANS_AXES[channel]}
     ag = corroborate.imitates(ratios, t_aero=cand.T_IN)
     if ag is None:
         return
     # the channels were corrected by the kinematic estimate already applied: the means see the rest
-    est, se = applied + ag.ratio * PROBE_BETA_BIAS, ag.std_error * PROBE_BETA_BIAS
-    c.details["lateral_means"] = {"estimate": est, "std_error": se, "applied_before": applied,
-                                  "axes": {a.axis: [a.ratio * PROBE_BETA_BIAS, a.std_error * PROBE_BETA_BIAS]
-                                           for a in ag.axes}}
-    sel, _ = _sensor_verdict("bias_beta", est, se, True, kin, p, False, True)
+    est, se = applied + ag.ratio * PROBE_VANE_BIAS, ag.std_error * PROBE_VANE_BIAS
+    c.details["vane_means"] = {"estimate": est, "std_error": se, "applied_before": applied,
+                               "axes": {a.axis: [a.ratio * PROBE_VANE_BIAS, a.std_error * PROBE_VANE_BIAS]
+                                        for a in ag.axes}}
+    sel, _ = _sensor_verdict(name, est, se, True, kin, p, False, True)
     if not sel:
         return
-    each = ", ".join(f"{a.axis} {np.degrees(a.ratio * PROBE_BETA_BIAS):.2f}° ± "
-                     f"{np.degrees(a.std_error * PROBE_BETA_BIAS):.2f}°" for a in ag.axes)
-    c.reason = (f"the model along the β vane is off by its own sideslip slopes times one constant on every lateral "
-                f"axis that can tell ({each}); the kinematics hardly see a β bias (there t = {c.t:.1f})")
+    each = ", ".join(f"{a.axis} {np.degrees(a.ratio * PROBE_VANE_BIAS):.2f}° ± "
+                     f"{np.degrees(a.std_error * PROBE_VANE_BIAS):.2f}°" for a in ag.axes)
+    c.reason = (f"the model along the {'α' if channel == 'alpha' else 'β'} vane is off by its own slopes times one "
+                f"constant on every axis that can tell ({each}); the kinematics alone: t = {c.t:.1f}")
     c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
-    c.test = BETA_BIAS_TEST
+    c.test = MEANS_TESTS[channel]
 
 
 def _name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature, applied: set[str],

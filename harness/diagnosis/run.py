@@ -16,7 +16,7 @@ from scipy import signal
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
-from harness.diagnosis.analysis import BETA_BIAS_TEST, Analysis, Candidate, analyse, name_replicated
+from harness.diagnosis.analysis import MEANS_TESTS, Analysis, Candidate, analyse, name_replicated
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, instruments_at_cg
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
@@ -191,8 +191,8 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     ``status`` is 'confirmed' (the mismatch RMS, summed over its axes in units of each axis's
     noise level, drops by 1 % or more), 'contradicted' (it rises by 1 % or more) or 'neutral'; None for a finding with no coefficient term (a
     sensor effect, a gust level, a spectral peak)."""
-    if f.test == BETA_BIAS_TEST:
-        return _lateral_means_check(av, f)
+    if f.test in MEANS_TESTS.values():
+        return _vane_means_check(av, f)
     if f.test.startswith("kinematic consistency") or f.parameter == "x_accelerometer":
         return _sensor_check(av, f)
     after, n_terms = _after_mismatch(av, [f])
@@ -310,16 +310,16 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
     return out
 
 
-def _lateral_means_check(av: Analysis, f: Candidate) -> dict:
-    """A β-vane bias named on the lateral coefficient means
-    (:func:`analysis._name_beta_bias_from_means`), tested the same way on the validation
-    maneuver: the same vane, so the same sign at |t| >= :data:`SENSOR_CONFIRM_T` there
-    ('confirmed'), the opposite sign at that |t| ('contradicted'), else 'neutral'."""
+def _vane_means_check(av: Analysis, f: Candidate) -> dict:
+    """A vane bias named on the coefficient means (:func:`analysis._name_vane_bias_from_means`),
+    tested the same way on the validation maneuver: the same vane, so the same sign at
+    |t| >= :data:`SENSOR_CONFIRM_T` there ('confirmed'), the opposite sign at that |t|
+    ('contradicted'), else 'neutral'."""
     twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
-    means = (twin.details.get("lateral_means") if twin is not None else None) or {}
+    means = (twin.details.get("vane_means") if twin is not None else None) or {}
     if not means:
         return {"status": "neutral", "axes": [], "estimate": None, "t": None,
-                "reason": "the validation maneuver's lateral means cannot tell a β bias"}
+                "reason": "the validation maneuver's coefficient means cannot tell this vane bias"}
     v, sv = means["estimate"], means["std_error"]
     t = v / sv if sv > 0 else 0.0
     same = np.sign(v) == np.sign(f.estimate)
