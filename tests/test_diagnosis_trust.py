@@ -393,3 +393,17 @@ def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
     assert abs(f["estimate"] - recorded_bias(c)) <= max(2 * f["std_error"], 0.02 * recorded_bias(c))
     assert f["evidence"]["validation"]["status"] == "confirmed"
     assert math.degrees(recorded_bias(c)) == pytest.approx(1.05)
+
+
+def test_a_sensor_finding_the_validation_contradicts_says_what_the_same_test_gave_there():
+    """run._finding_dict: a sensor test's check carries no mismatch 'change' (a KeyError, an
+    internal error, before); the text gives the estimate the same test made on the
+    validation maneuver."""
+    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.run import _finding_dict
+    f = Candidate("sensor_bias", None, "beta", "bias_beta", 0.0184, 6e-5, 300.0, 0.0, "rad",
+                  "lateral coefficient means along the β vane", selected=True)
+    check = {"status": "contradicted", "axes": ["CY", "Cl", "Cn"], "estimate": -0.00698, "std_error": 4.3e-05,
+             "t": -162.9}
+    text = _finding_dict(f, {}, {}, check)["explanation"]
+    assert "the same test there gives -0.00698 ± 4.3e-05 rad, t = -162.9" in text
