@@ -998,12 +998,11 @@ REPLICATED_EACH_T = AMBIGUOUS_T
 
 
 def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
-    """Name the sensor errors that the identification's kinematics only suspect (|t| at least
+    """Name the sensor biases that the identification's kinematics only suspect (|t| at least
     :data:`REPLICATED_EACH_T`, below the entry t) and the validation's show too (|t| at least
     as much, the same sign, sizes within two standard errors), when their inverse-variance
-    combination
-    reaches the kinematic entry t (:data:`kinematics.T_IN`): the same instrument flew both,
-    and their kinematic residuals carry independent noise. Not when either record's
+    combination reaches the kinematic entry t (:data:`kinematics.T_IN`): the same instrument
+    flew both, and their kinematic residuals carry independent noise. Not when either record's
     kinematics are void (turbulence, light gusts, implausible estimates), when the
     identification's kinematics cannot tell the parameter from a rival
     (:func:`_kinematic_rival`), or when the combined size is not practical and precise
@@ -1036,8 +1035,7 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
         est, se = (w1 * c.estimate + w2 * v.estimate) / (w1 + w2), (w1 + w2) ** -0.5
         if abs(est) / se < KIN_T_IN or _kinematic_rival(kin, c.parameter) is not None:
             continue
-        sel, why = _sensor_verdict(c.parameter, est, se, True, kin, p, False, True)
-        if not sel:
+        if not _sensor_verdict(c.parameter, est, se, True, kin, p, False, True)[0]:
             continue
         c.details["replication"] = {"identification": [c.estimate, c.std_error],
                                     "validation": [v.estimate, v.std_error], "combined": [est, se]}
