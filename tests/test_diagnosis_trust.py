@@ -392,6 +392,7 @@ def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
     assert set(f["evidence"]["vane_means"]["axes"]) == {"CY", "Cl", "Cn"}
     assert abs(f["estimate"] - recorded_bias(c)) <= max(2 * f["std_error"], 0.02 * recorded_bias(c))
     assert f["evidence"]["validation"]["status"] == "confirmed"
+    assert f["explanation"].startswith("The beta vane reads 0.0184") and "kinematics" not in f["explanation"]
     assert math.degrees(recorded_bias(c)) == pytest.approx(1.05)
 
 

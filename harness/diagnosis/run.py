@@ -586,6 +586,11 @@ def _offset_direction(parameter: str, estimate: float) -> tuple[str, str]:
     return axis, ahead if estimate >= 0 else behind
 
 
+# A vane bias named on the coefficient means (analysis._name_vane_bias_from_means).
+EXPLAIN_VANE_MEANS = ("The {channel} vane reads {estimate:.4g} ± {std_error:.2g} {units} off: the model evaluated "
+                      "along it is off by its own slopes in that angle times one constant on every axis it reaches.")
+
+
 def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = None) -> dict:
     fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
            "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
@@ -598,8 +603,9 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
     fmt["product"] = "|beta|, an even function of sideslip" if even else "(alpha - alpha_trim)·beta"
     fmt["even"] = (" (or, as here, the model has one of opposite sign: a symmetric airframe's rolling and yawing "
                    "moments are odd in sideslip)") if even else ""
+    template = EXPLAIN_VANE_MEANS if c.test in MEANS_TESTS.values() else EXPLAIN[c.effect]
     try:
-        text = EXPLAIN[c.effect].format(**fmt)
+        text = template.format(**fmt)
     except (KeyError, ValueError):
         text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
