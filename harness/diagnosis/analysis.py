@@ -772,6 +772,19 @@ VANE_MEANS_AXES = {"beta": cand.LAT}
 MEANS_TESTS = {"beta": "lateral coefficient means along the β vane"}
 
 
+def birge_scaled(ag: corroborate.Agreement) -> float:
+    """The common ratio's standard error, scaled by the Birge ratio √(χ²/(k − 1)) of the axes'
+    scatter about it when that exceeds 1: the colored-residual errors of a constant are
+    small, and the axes then disagree by more than they allow because the model's own slopes
+    carry errors too (R. T. Birge, Phys. Rev. 40, 207 (1932), the calculation of errors by
+    the method of least squares)."""
+    k = len(ag.axes)
+    if k < 2:
+        return ag.std_error
+    chi2 = sum(((a.ratio - ag.ratio) / a.std_error) ** 2 for a in ag.axes)
+    return ag.std_error * max(1.0, float(np.sqrt(chi2 / (k - 1))))
+
+
 def _name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
                                ic: InitialCondition, step: _Stepwise, channel: str, applied: float = 0.0) -> None:
     """Name a vane bias (``channel``; :data:`VANE_MEANS_AXES`) from the coefficients' means
@@ -804,7 +817,9 @@ def _name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: 
     if ag is None:
         return
     # the channels were corrected by the kinematic estimate already applied: the means see the rest
-    est, se = applied + ag.ratio * PROBE_VANE_BIAS, ag.std_error * PROBE_VANE_BIAS
+    est, se = applied + ag.ratio * PROBE_VANE_BIAS, birge_scaled(ag) * PROBE_VANE_BIAS
+    if abs(est - applied) < cand.T_IN * se:
+        return
     c.details["vane_means"] = {"estimate": est, "std_error": se, "applied_before": applied,
                                "axes": {a.axis: [a.ratio * PROBE_VANE_BIAS, a.std_error * PROBE_VANE_BIAS]
                                         for a in ag.axes}}
