@@ -818,13 +818,11 @@ def _name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: 
         return
     # the channels were corrected by the kinematic estimate already applied: the means see the rest
     est, se = applied + ag.ratio * PROBE_VANE_BIAS, birge_scaled(ag) * PROBE_VANE_BIAS
-    if abs(est - applied) < cand.T_IN * se:
-        return
     c.details["vane_means"] = {"estimate": est, "std_error": se, "applied_before": applied,
                                "axes": {a.axis: [a.ratio * PROBE_VANE_BIAS, a.std_error * PROBE_VANE_BIAS]
                                         for a in ag.axes}}
-    sel, _ = _sensor_verdict(name, est, se, True, kin, p, False, True)
-    if not sel:
+    # named only when the means alone, their scatter allowed for, stand at the entry t
+    if abs(est - applied) < cand.T_IN * se or not _sensor_verdict(name, est, se, True, kin, p, False, True)[0]:
         return
     each = ", ".join(f"{a.axis} {np.degrees(a.ratio * PROBE_VANE_BIAS):.2f}° ± "
                      f"{np.degrees(a.std_error * PROBE_VANE_BIAS):.2f}°" for a in ag.axes)
