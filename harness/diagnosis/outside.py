@@ -587,14 +587,9 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
         rec, answer = postprocess(flight, noise=not c.clean, seed=1000 * c.seed + i, drop=c.drop,
                                   mode=c.mode, aircraft_label=label, noise_model=noise)
         if cv.vanes_ft:  # the team knows where its nose boom is
-            pos = [cv.vanes_ft, 0.0, 0.0]
-            rec = Recording(data=rec.data, meta={**rec.meta, "sensors": {**(rec.meta.get("sensors") or {}),
-                                                                         "alpha_vane_ft": pos, "beta_vane_ft": pos}},
-                            name=rec.name)
+            rec = with_sensors(rec, alpha_vane_ft=[cv.vanes_ft, 0.0, 0.0], beta_vane_ft=[cv.vanes_ft, 0.0, 0.0])
         if any(cv.accelerometer_ft):  # and where its accelerometer is
-            rec = Recording(data=rec.data, meta={**rec.meta, "sensors": {**(rec.meta.get("sensors") or {}),
-                                                                         "accelerometer_ft": list(cv.accelerometer_ft)}},
-                            name=rec.name)
+            rec = with_sensors(rec, accelerometer_ft=list(cv.accelerometer_ft))
         paths[role] = write_recording(rec, out_dir / f"{c.name}-{role}.csv")
         if cv.units != "canonical":  # the writer writes canonical units only; the reader takes these
             rewrite_in_units(paths[role], OTHER_UNITS)
@@ -613,6 +608,13 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
 # The 'deg-kts' convention: every quantity that has one in recording-format.md's table in its
 # other accepted unit (angles in deg, rates in deg/s, airspeed in kts, altitude in m).
 OTHER_UNITS = {"rad": "deg", "rps": "dps", "V_fps": "kts", "h_ft": "m"}
+
+
+def with_sensors(rec: Recording, **positions: list[float]) -> Recording:
+    """``rec`` with sensor positions (ft from the c.g., body axes) written into its metadata's
+    ``sensors`` block, as a team that knows them would."""
+    sensors = {**(rec.meta.get("sensors") or {}), **positions}
+    return Recording(data=rec.data, meta={**rec.meta, "sensors": sensors}, name=rec.name)
 
 
 def vanes_ahead(rec: Recording, x_ft: float) -> Recording:

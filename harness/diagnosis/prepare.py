@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from estimators.coefficients import accelerometer_at_cg, force_coefficients, moment_coefficients
+from estimators.differentiation import local_polynomial_derivative
 from estimators.smoothing import optimal_fourier_smoother, sine_series_derivative, sine_series_filter
 from harness.isa import density_altitude_ft
 from maneuvers.recording import Recording
@@ -147,15 +147,16 @@ ACCEL_DERIVATIVE_WINDOW_S = 0.2
 
 
 def angular_accelerations(rec: Recording) -> list[np.ndarray]:
-    """ṗ, q̇, ṙ (rad/s²): the recorded pdot/qdot/rdot when present, else a cubic
-    Savitzky-Golay derivative of the rates over :data:`ACCEL_DERIVATIVE_WINDOW_S`."""
+    """ṗ, q̇, ṙ (rad/s²): the recorded pdot/qdot/rdot when present, else the rates' cubic
+    local-polynomial (Savitzky-Golay) derivative over :data:`ACCEL_DERIVATIVE_WINDOW_S`
+    (:func:`estimators.differentiation.local_polynomial_derivative`, seed Eq. 24)."""
     d = rec.data
     if all(f"{c}dot_rps2" in d.columns for c in "pqr"):
         return [d[f"{c}dot_rps2"].to_numpy(dtype=float) for c in "pqr"]
-    t = d["t_s"].to_numpy(dtype=float)
-    dt = float(np.median(np.diff(t)))
-    n = min(max(5, 2 * int(round(0.5 * ACCEL_DERIVATIVE_WINDOW_S / dt)) + 1), t.size - (1 - t.size % 2))
-    return [savgol_filter(d[f"{c}_rps"].to_numpy(dtype=float), n, 3, deriv=1, delta=dt) for c in "pqr"]
+    half = max(2, int(round(0.5 * ACCEL_DERIVATIVE_WINDOW_S / rec.dt)))
+    window = min(2 * half + 1, rec.n - (1 - rec.n % 2))  # odd, and no longer than the record
+    return [local_polynomial_derivative(d[f"{c}_rps"].to_numpy(dtype=float), rec.dt, window=window, order=3)
+            for c in "pqr"]
 
 
 def accelerometer_to_cg(rec: Recording) -> Recording:

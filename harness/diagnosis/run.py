@@ -294,8 +294,7 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
         return {"status": "neutral", "axes": [], "estimate": None, "t": None,
                 "reason": "the validation maneuver does not test this parameter"}
     same = np.sign(twin.estimate) == np.sign(f.estimate)
-    status = ("confirmed" if same and abs(twin.t) >= SENSOR_CONFIRM_T else
-              "contradicted" if not same and abs(twin.t) >= SENSOR_CONFIRM_T else "neutral")
+    status = _same_instrument_status(twin.estimate, twin.t, f.estimate)
     out = {"status": status, "axes": [], "estimate": float(twin.estimate), "std_error": float(twin.std_error),
            "t": float(twin.t)}
     kin = f.details.get("corroboration") or {}
@@ -322,11 +321,17 @@ def _vane_means_check(av: Analysis, f: Candidate) -> dict:
                 "reason": "the validation maneuver's coefficient means cannot tell this vane bias"}
     v, sv = means["estimate"], means["std_error"]
     t = v / sv if sv > 0 else 0.0
-    same = np.sign(v) == np.sign(f.estimate)
-    status = ("confirmed" if same and abs(t) >= SENSOR_CONFIRM_T else
-              "contradicted" if not same and abs(t) >= SENSOR_CONFIRM_T else "neutral")
-    return {"status": status, "axes": list(means["axes"]), "estimate": float(v), "std_error": float(sv),
-            "t": float(t)}
+    return {"status": _same_instrument_status(v, t, f.estimate), "axes": list(means["axes"]), "estimate": float(v),
+            "std_error": float(sv), "t": float(t)}
+
+
+def _same_instrument_status(there: float, t_there: float, here: float) -> str:
+    """The validation maneuver's verdict on a sensor finding of size ``here``: the same test
+    there gave ``there`` at ``t_there``; the same sign at |t| >= :data:`SENSOR_CONFIRM_T` is
+    'confirmed', the opposite sign at that |t| 'contradicted', anything else 'neutral'."""
+    if abs(t_there) < SENSOR_CONFIRM_T:
+        return "neutral"
+    return "confirmed" if np.sign(there) == np.sign(here) else "contradicted"
 
 
 def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
@@ -948,7 +953,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     if validation is not None:
         pv, av, befores["validation"] = (pending.result() if pending is not None else
                                          _analysed(recs["validation"], "validation", aircraft))
-    if validation is not None:  # sensor errors each maneuver only suspects, named on the two
+    if validation is not None:  # sensor biases each maneuver only suspects, named on the two
         name_replicated(a, av)
     findings = _findings(a)
     checks: dict[int, dict | None] = {}
