@@ -409,8 +409,11 @@ def _start_campaign(tmp_path: Path) -> tuple[subprocess.Popen, Path, list[str]]:
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "harness", "campaign", str(path), "--out", str(out), "--workers", "2",
            "--cache", str(tmp_path / "cache"), "--quiet"]
+    # a shell without job control starts background jobs with SIGINT ignored, and the child
+    # would inherit that: Ctrl-C is given its default disposition back, as a terminal has it
     proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            env=dict(os.environ, PYTHONPATH=str(ROOT)))
+                            env=dict(os.environ, PYTHONPATH=str(ROOT)),
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 180
     while time.monotonic() < deadline and len(list((out / "tasks").glob("*.parquet"))) < 3:
         assert proc.poll() is None, proc.stderr.read().decode()

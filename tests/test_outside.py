@@ -323,3 +323,35 @@ def test_an_accelerometer_away_from_the_cg_and_declared_comes_back_to_it():
     for c in ("ax_g", "ay_g", "az_g"):
         assert np.allclose(back.data[c], d[c], atol=1e-13)
     assert Convention(accelerometer_ft=pos).describe() == "accelerometer x10 y2 z3 ft"
+
+
+def test_light_turbulence_on_a_slow_aircraft_is_named_as_air(tmp_path):
+    """Outside case C1 (c172x at 180 ft/s, Dryden severity 2): the 1.9 ft/s gust is 0.6 deg of
+    angle; the C_Z mismatch carries none of the vane-against-inertial difference (the
+    aircraft flew the vane's angle), so the gust is air: named light turbulence, nothing
+    else, its air share and the sensor tests' reason in the evidence."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "C1_three_axis_light_turbulence_sev2")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["c"] == 0, row["first"]
+    first = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
+    share = first["evidence"]["air_share"]
+    assert share["share"] >= 0.5 + 3 * share["std_error"] and first["evidence"]["light"]
+    assert "light turbulence" in first["explanation"]
+
+
+def test_vanes_wandering_as_far_as_gusts_are_not_turbulence(tmp_path):
+    """Outside null H_pitch with a 0.4 deg vane wander at 700 ft/s: 4.4 ft/s of "gust", which
+    named turbulence before the air-share test, and C_Z,α −2.47 once it did not. The
+    aerodynamics did not follow the vanes: `none`, and not_checked says why α terms were
+    not offered."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "H_pitch_none_vanewander0.4deg")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["c"] == 0, row["findings"]
+    result = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
+    gust = next(x for x in result["candidates"] if x["effect"] == "turbulence")
+    share = float(gust["reason"].split("air share ")[1].split(" ")[0])
+    assert gust["estimate"] >= 3.0 and not gust["selected"] and share < 0.25
+    assert any("vane error, not turbulence" in x["reason"] and x["effect"] == "coefficient_error"
+               for x in result["not_checked"])

@@ -18,7 +18,7 @@ from harness.diagnosis.kinematics import (KinematicResult, PRACTICAL, channel_sh
                                           inertial_angles, is_plausible, is_practical, kinematic_check,
                                           kinematic_residuals)
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, measured_coefficients
-from harness.diagnosis.spectra import FISHER_P, gust_estimate, structural_peak
+from harness.diagnosis.spectra import FISHER_P, AirShare, air_share, gust_estimate, structural_peak
 from models.aircraft import Aircraft, has_propeller
 from models.hidden import SENSOR_EFFECTS
 from models.replay import AeroAlong, InitialCondition, aero_along
@@ -67,6 +67,7 @@ class Analysis:
     not_offered: dict = field(default_factory=dict)  # per axis: candidate parameters the maneuver did not excite
     applied: dict = field(default_factory=dict)      # sensor corrections applied before the model was evaluated
     gusty: str = ""  # why light gusts leave the kinematic (sensor) tests untrustworthy ('' when they do not)
+    air: AirShare | None = None  # the air-share test, when the kinematics showed gusts
 
 
 def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
@@ -94,12 +95,15 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     contested = _contested(kin)
     sensor_values = {n: v for n, v in _sensor_values(kin, turbulent or bool(gusty), plausible).items()
                      if n not in contested}
-    cands = _kinematic_candidates(kin, p, turbulent, plausible, gusty)
     recorded, p = p, _corrected(p, kin, sensor_values)
     # 2. the model along the measured states
     along = model_along(p, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along
     mismatch = along.mismatch()
+    # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)
+    air = _air_share(p, aircraft, ic, along, gust, V0) if turbulent or gusty else None
+    turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0)
+    cands = _kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
     as_evaluated = dict(mismatch)
@@ -119,6 +123,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     else:
         if gusty:
             _withhold_in_light_gusts(cands, gusty)
+        if vane_wander(air):
+            _withhold_vane_wander(cands, gusty)
         signature = _signature_ratios(cands, kin, p, aircraft, ic, mismatch, step)
         if plausible and not gusty:
             _kinematic_rivals(cands, kin, p, signature, contested)
@@ -131,12 +137,12 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
     # 6. spectra and gusts
     peak = structural_peak(p)
-    cands += _spectral_candidates(peak, gust, turbulent)
-    if turbulent:  # the gust as a process-noise model: filter error against output error
+    cands += _spectral_candidates(peak, gust, turbulent, light, air)
+    if turbulent or light:  # the gust as a process-noise model: filter error against output error
         next(c for c in cands if c.effect == "turbulence").details["process_noise_model"] = process_noise_model(p)
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
                     selections=step.selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
-                    not_offered=step.not_offered, applied=dict(sensor_values), gusty=gusty)
+                    not_offered=step.not_offered, applied=dict(sensor_values), gusty=gusty, air=air)
 
 
 def _turbulence(p: Prepared):
@@ -146,6 +152,58 @@ def _turbulence(p: Prepared):
                          0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * G0_FPS2)
     turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
     return gust, turbulent
+
+
+def _air_share(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, gust, V0: float) -> AirShare:
+    """The air-share test (:func:`spectra.air_share`) on C_Z and the vertical gust, along
+    the α vane's own record: where the maneuver did not drive α the model holds it at its
+    start (:func:`model_states`), and is evaluated again along the vane for the test."""
+    if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0:
+        along = model_along(p, aircraft, ic, vanes=True)
+    states = dict(along.states)
+    states["alpha"] = np.asarray(states["alpha"], dtype=float) + rivals.SLOPE_STEP_RAD
+    moved = aero_along(aircraft, ic, states, along.surfaces, along.alphadot)
+    slope = (moved.coefficients["CZ"] - along.aero.coefficients["CZ"]) / rivals.SLOPE_STEP_RAD
+    nuisances = [p.smooth[c] for c in ("alpha", "beta", "p", "q", "r") if c in p.smooth]
+    return air_share(-gust.w_fps / V0, slope, along.mismatch()["CZ"], nuisances, p.dt)
+
+
+def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: float) -> tuple[bool, bool, str]:
+    """``(turbulent, light, gusty)`` once the air-share test has spoken.
+
+    Turbulence stands only if the aerodynamics followed the vanes: an air share
+    significantly under :data:`AIR_SHARE_MIN` (two standard errors) says the kinematic
+    residual is vane error (a wandering vane at high speed reaches the gust level a
+    turbulence finding needs), and the recording is then treated as gusty (no sensor value
+    applied, none named). Light gusts (:func:`light_gusts`) are named light turbulence when
+    the share is at least :data:`AIR_SHARE_MIN` and :data:`AIR_T` standard errors above 0."""
+    if air is None:
+        return turbulent, False, gusty
+    is_air = air.share >= AIR_SHARE_MIN and air.share >= AIR_T * air.std_error
+    not_air = air.share + 2.0 * air.std_error < AIR_SHARE_MIN
+    if not_air:
+        sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
+        return False, False, (f"the vanes and the inertial channels disagree by {np.degrees(air.angle_rad):.2f} deg "
+                              f"RMS ({sigma:.1f} ft/s at {V0:.0f} ft/s), but the aerodynamics did not follow the "
+                              f"vanes (air share {air.share:.2f} ± {air.std_error:.2f}): vane error, not turbulence, "
+                              "and it breaks the kinematic consistency the sensor tests rest on")
+    return turbulent, bool(gusty) and is_air, gusty
+
+
+def vane_wander(air: AirShare | None) -> bool:
+    """Whether the air-share test put the vane-against-inertial difference on the vanes."""
+    return air is not None and air.share + 2.0 * air.std_error < AIR_SHARE_MIN
+
+
+def _withhold_vane_wander(cands: list[Candidate], why: str) -> None:
+    """When the vane-against-inertial difference is vane error (:func:`vane_wander`), the
+    model evaluated along the α vane carries C_α times that error, and the α columns carry
+    it too (errors in variables): terms in α, its powers and α̇ are not named. A 0.4 deg
+    wander at 700 ft/s named C_Z,α −2.47 (model −4.3) on a null of the outside sweep."""
+    for c in cands:
+        if c.selected and c.test.startswith("stepwise") and c.parameter.split("_", 1)[-1].startswith("alpha"):
+            c.selected = False
+            c.reason = f"not named: {why}"
 
 
 def light_gusts(gust, p: Prepared, V0: float) -> str:
@@ -417,9 +475,11 @@ def _slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, 
     return slope_of
 
 
-def _spectral_candidates(peak, gust, turbulent: bool) -> list[Candidate]:
+def _spectral_candidates(peak, gust, turbulent: bool, light: bool = False,
+                         air: AirShare | None = None) -> list[Candidate]:
     """The structural-mode peak (named at p < :data:`FISHER_P`) and the gust level (named in
-    turbulence)."""
+    turbulence, and in light turbulence the air-share test confirms: then the part of the
+    vertical gust that is air, σ_w √(1 − k))."""
     out = []
     if peak is not None:
         sel = peak.p_value < FISHER_P
@@ -429,10 +489,19 @@ def _spectral_candidates(peak, gust, turbulent: bool) -> list[Candidate]:
                              f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else ""),
                              {"amplitude": peak.amplitude}))
     sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
+    details = {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}
+    reason = f"gust/noise ratio {gust.ratio_to_noise:.1f}"
+    if air is not None:
+        details["air_share"] = {"share": air.share, "std_error": air.std_error,
+                                "angle_deg": float(np.degrees(air.angle_rad))}
+        reason += f"; air share {air.share:.2f} ± {air.std_error:.2f}"
+    if light:
+        sigma = gust.sigma_w_fps * float(np.sqrt(min(max(air.share, 0.0), 1.0)))
+        details["light"] = True
+        reason += " (light turbulence: the aerodynamics followed the vanes' angle, the air's)"
     out.append(Candidate("turbulence", None, None, "sigma_gust_fps", sigma, sigma / 4.0, gust.ratio_to_noise, 0.0,
-                         "ft/s", "air-relative vs inertial velocity (integrated kinematic residual)", turbulent,
-                         f"gust/noise ratio {gust.ratio_to_noise:.1f}",
-                         {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}))
+                         "ft/s", "air-relative vs inertial velocity (integrated kinematic residual)",
+                         turbulent or light, reason, details))
     return out
 
 
@@ -1124,6 +1193,13 @@ GUST_ANGLE_FACTOR = 2.5
 # air; a noise-free recording's 0.04 ft/s is no gust either.
 VANE_NOISE_FLOOR_RAD = np.radians(0.1)
 NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"
+# The air-share test (spectra.air_share): gusts are named when at least half the vane-vs-
+# inertial angle difference is air, AIR_T standard errors above none. Outside sweep (2 Dec
+# 2026): nulls 0.0-0.65 (k 0.35-1.16, the lowest on lateral maneuvers with little pitch);
+# Dryden severity 2 at 180-330 ft/s 0.9-1.1; severity 3-4 0.9-1.3; a 0.2 deg vane wander
+# -0.08 ± 0.03.
+AIR_SHARE_MIN = 0.5
+AIR_T = 4.0
 
 
 def _practical_size(name: str, dt: float) -> float:

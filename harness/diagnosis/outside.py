@@ -505,6 +505,10 @@ def _convention_cases() -> list[OutsideCase]:
         ("C1", "three_axis", Convention(accelerometer_ft=(4.0, 1.0, 2.0)), None),
         ("M", "pitch", Convention(accelerometer_ft=(10.0, 2.0, 3.0)),
          (H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q")),
+        # vanes wandering as far as a gust moves them: at 700 ft/s a 0.4 deg wander is the
+        # 3 ft/s a turbulence finding needs, at 180 ft/s the angle light gusts make
+        ("H", "pitch", Convention(gauss_markov_deg=0.4), None),
+        ("C1", "three_axis", Convention(gauss_markov_deg=0.4), None),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):

@@ -16,7 +16,7 @@ from scipy import signal
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
-from harness.diagnosis.analysis import MEANS_TESTS, Analysis, Candidate, analyse, name_replicated
+from harness.diagnosis.analysis import MEANS_TESTS, Analysis, Candidate, analyse, name_replicated, vane_wander
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, instruments_at_cg
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
@@ -58,6 +58,13 @@ EXPLAIN = {
     "turbulence": "The air-relative and inertial velocities disagree broadband (gust RMS about {estimate:.1f} ft/s): "
                   "the flight was in turbulence, which no deterministic model term can replay.",
 }
+
+
+EXPLAIN_LIGHT_TURBULENCE = (
+    "The air-relative and inertial velocities disagree broadband, and the aerodynamics followed the air-relative "
+    "angle (air share {air_share:.2f} ± {air_share_se:.2f} of the vane-against-inertial difference): the flight was "
+    "in light turbulence (vertical gust RMS about {estimate:.1f} ft/s). Too light to bias the equation-error terms, "
+    "which stand; the sensor tests, which need the kinematics to hold, do not.")
 
 
 # A mismatch left at this many times its noise level is reported as unexplained (noise in
@@ -136,9 +143,16 @@ def _terms_of(findings: list[Candidate], applied: dict[str, float]) -> tuple[Hid
 
 def _findings(analysis: Analysis) -> list[Candidate]:
     """The selected candidates, most significant first; turbulence, when named, leads: it is
-    the broadband mismatch every deterministic term is then fitted against."""
+    the broadband mismatch every deterministic term is then fitted against. Light turbulence
+    (the deterministic terms stand in it) follows them."""
     chosen = [c for c in analysis.candidates if c.selected]
-    return sorted(chosen, key=lambda c: (c.effect != "turbulence", -abs(c.t)))
+    return sorted(chosen, key=lambda c: (_turbulence_rank(c), -abs(c.t)))
+
+
+def _turbulence_rank(c: Candidate) -> int:
+    if c.effect != "turbulence":
+        return 1
+    return 2 if c.details.get("light") else 0
 
 
 def _sim_channels(hist) -> dict[str, np.ndarray]:
@@ -608,7 +622,10 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
     fmt["product"] = "|beta|, an even function of sideslip" if even else "(alpha - alpha_trim)·beta"
     fmt["even"] = (" (or, as here, the model has one of opposite sign: a symmetric airframe's rolling and yawing "
                    "moments are odd in sideslip)") if even else ""
-    template = EXPLAIN_VANE_MEANS if c.test in MEANS_TESTS.values() else EXPLAIN[c.effect]
+    template = (EXPLAIN_VANE_MEANS if c.test in MEANS_TESTS.values() else
+                EXPLAIN_LIGHT_TURBULENCE if c.details.get("light") else EXPLAIN[c.effect])
+    share = c.details.get("air_share") or {}
+    fmt["air_share"], fmt["air_share_se"] = share.get("share", float("nan")), share.get("std_error", float("nan"))
     try:
         text = template.format(**fmt)
     except (KeyError, ValueError):
@@ -715,6 +732,9 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
     if a.gusty:
         out += [{"effect": e, "parameters": [], "reason": a.gusty}
                 for e in ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")]
+    if vane_wander(a.air):
+        out.append({"effect": "coefficient_error", "parameters": ["terms in alpha, its powers and alphadot"],
+                    "reason": a.gusty})
     out.append({"effect": "structural_mode", "parameters": [],
                 "reason": f"only modes below {0.5 / p.dt:g} Hz (half the sample rate) can be seen"})
     if not validation_given:

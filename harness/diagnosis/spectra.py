@@ -8,10 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage, signal, stats
 
+from estimators.colored_stepwise import colored_fit
 from harness.diagnosis.prepare import Prepared
 
 MODE_CHANNELS = ("p", "q", "r", "ax", "ay", "az")
 FISHER_P = 1e-6  # a peak must beat white noise at this level (Fisher's g test, all channels)
+GUST_HIGHPASS_HZ = 0.05  # the gust estimate drops what sensor-bias drift puts below this
 
 
 @dataclass(frozen=True)
@@ -112,7 +114,7 @@ def gust_estimate(kin_residuals: dict[str, np.ndarray], p: Prepared, noise_accel
     """RMS gust velocities from the kinematic residuals of the w and v equations: in
     turbulence the air-relative velocity differs from the inertial one by the gust, so
     E_w ≈ ẇ_gust; its integral (high-passed at 0.05 Hz to drop sensor-bias drift) is the gust."""
-    b, a = signal.butter(2, 0.05, btype="highpass", fs=1.0 / p.dt)
+    b, a = signal.butter(2, GUST_HIGHPASS_HZ, btype="highpass", fs=1.0 / p.dt)
     k = max(1, int(round(1.0 / p.dt)))
 
     def gust(e: np.ndarray) -> np.ndarray:
@@ -129,6 +131,51 @@ def gust_estimate(kin_residuals: dict[str, np.ndarray], p: Prepared, noise_accel
     floor = noise_accel_fps2 * float(np.sqrt(np.sum(response ** 2)))
     gu = gust(kin_residuals["u"]) if "u" in kin_residuals else None
     return GustEstimate(sw, sv, max(sw, sv) / max(floor, 1e-12), gw, gv, gu)
+
+
+@dataclass(frozen=True)
+class AirShare:
+    """How much of the vane-against-inertial angle difference the aerodynamics followed."""
+    share: float       # 1 - k: 0 when the difference is all vane error, 1 when it is all air
+    std_error: float   # colored-residual standard error (seed Eq. 40)
+    angle_rad: float   # RMS of the angle difference (integrated, high-passed kinematic residual / V)
+
+
+def air_share(angle_difference: np.ndarray, slope: np.ndarray, mismatch: np.ndarray,
+              nuisances: list[np.ndarray], dt: float) -> AirShare:
+    """Tell gusts from vane errors by what the aerodynamics did.
+
+    The kinematic residual gives the difference e between the vane's angle and the one the
+    inertial channels integrate to (:func:`gust_estimate`: e = -w_gust/V). If e is vane
+    error n, the model evaluated along the vane is off by C_α·n, and the measured-minus-model
+    coefficient carries ΔC = -C_α·n = -C_α·e; if e is air (a gust), the aircraft flew the
+    vane's angle and ΔC carries none of it. The least-squares k in
+    ΔC = k·(-C_α e) + nuisances + b, both high-passed as the gust estimate is, is the share
+    that is vane error, and 1 - k the share that is air.
+
+    Parameters
+    ----------
+    angle_difference : e (rad), the gust history over the airspeed with its sign flipped.
+    slope : the model's ∂C/∂α along the states (per rad), C_Z's for the vertical gust.
+    mismatch : the measured-minus-model coefficient ΔC.
+    nuisances : maneuver-driven columns (the measured states) that soak up model error
+        correlated with the maneuver.
+    dt : sample interval (s).
+
+    Returns
+    -------
+    AirShare with 1 - k, its colored-residual standard error and the RMS of e; the first and
+    last second are left out, where the filters start.
+    """
+    b, a = signal.butter(2, GUST_HIGHPASS_HZ, btype="highpass", fs=1.0 / dt)
+    k = max(1, int(round(1.0 / dt)))
+    inner = slice(k, len(mismatch) - k)
+    def hp(x: np.ndarray) -> np.ndarray:
+        return signal.filtfilt(b, a, np.asarray(x, dtype=float))[inner]
+    e = np.asarray(angle_difference, dtype=float)
+    theta, se, _ = colored_fit(hp(mismatch), [(-slope * e)[inner]] + [hp(x) for x in nuisances],
+                               ["k"] + [f"n{i}" for i in range(len(nuisances))])
+    return AirShare(1.0 - float(theta[0]), float(se[0]), float(np.std(e[inner])))
 
 
 def gust_wind_ned(gust: GustEstimate, phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> dict[str, np.ndarray]:
