@@ -61,11 +61,15 @@ def test_turbulence_stands_only_if_the_aerodynamics_followed_the_vanes():
     vane = AirShare(0.01, 0.02, np.radians(0.36))
     turbulent, light, why = gust_verdict(gust, vane, True, "", 700.0)
     assert not turbulent and not light and "vane error, not turbulence" in why and "0.36 deg" in why
-    assert vane_wander(vane)
+    assert vane_wander(vane, why) and not vane_wander(vane, "")
     air = AirShare(0.99, 0.03, np.radians(0.6))
     assert gust_verdict(gust, air, True, "", 700.0) == (True, False, "")
     assert gust_verdict(gust, air, False, "gusts of about 1.9 ft/s", 180.0) == (False, True, "gusts of about 1.9 ft/s")
     undecided = AirShare(AIR_SHARE_MIN, AIR_SHARE_MIN / (AIR_T - 1.0), np.radians(0.3))
     assert gust_verdict(gust, undecided, False, "gusty", 180.0) == (False, False, "gusty")
-    assert not vane_wander(undecided)
+    assert not vane_wander(undecided, "gusty")
+    # gusts just under the light-gust angle: named only when the test says air
+    assert gust_verdict(gust, air, False, "", 330.0, "gusts near") == (False, True, "gusts near")
+    assert gust_verdict(gust, vane, False, "", 330.0, "gusts near") == (False, False, "")
+    assert gust_verdict(gust, undecided, False, "", 330.0, "gusts near") == (False, False, "")
     assert gust_verdict(gust, None, True, "", 700.0) == (True, False, "")

@@ -325,13 +325,14 @@ def test_an_accelerometer_away_from_the_cg_and_declared_comes_back_to_it():
     assert Convention(accelerometer_ft=pos).describe() == "accelerometer x10 y2 z3 ft"
 
 
-def test_light_turbulence_on_a_slow_aircraft_is_named_as_air(tmp_path):
-    """Outside case C1 (c172x at 180 ft/s, Dryden severity 2): the 1.9 ft/s gust is 0.6 deg of
-    angle; the C_Z mismatch carries none of the vane-against-inertial difference (the
-    aircraft flew the vane's angle), so the gust is air: named light turbulence, nothing
-    else, its air share and the sensor tests' reason in the evidence."""
+@pytest.mark.parametrize("name", ["C1_three_axis_light_turbulence_sev2", "L_pitch_light_turbulence_sev2"])
+def test_light_turbulence_on_a_slow_aircraft_is_named_as_air(name, tmp_path):
+    """Outside cases C1 (c172x at 180 ft/s) and L (F-16 at 330 ft/s, 2.49 times the vanes'
+    noise: under the light-gust angle), Dryden severity 2: the C_Z mismatch carries none of
+    the vane-against-inertial difference (the aircraft flew the vane's angle), so the gust
+    is air: named light turbulence, nothing else, its air share in the evidence."""
     from harness.diagnosis.outside import cases, run_case
-    c = next(c for c in cases() if c.name == "C1_three_axis_light_turbulence_sev2")
+    c = next(c for c in cases() if c.name == name)
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["c"] == 0, row["first"]
     first = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]

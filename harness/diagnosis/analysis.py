@@ -89,6 +89,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     gust, turbulent = _turbulence(p)
     V0 = float(np.mean(p.smooth["V"]))
     gusty = "" if turbulent else light_gusts(gust, p, V0)
+    near = "" if turbulent or gusty else light_gusts(gust, p, V0, LIGHT_TURBULENCE_FACTOR)
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)
     plausible = _kinematics_plausible(kin, V0)
@@ -101,8 +102,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     states, surfaces, alphadot, aero, measured = along
     mismatch = along.mismatch()
     # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)
-    air = _air_share(p, aircraft, ic, along, gust, V0) if turbulent or gusty else None
-    turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0)
+    near = near if not sensor_values else ""  # a corrected recording is not asked again
+    air = _air_share(p, aircraft, ic, along, gust, V0) if turbulent or gusty or near else None
+    turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
     cands = _kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
@@ -123,7 +125,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     else:
         if gusty:
             _withhold_in_light_gusts(cands, gusty)
-        if vane_wander(air):
+        if vane_wander(air, gusty):
             _withhold_vane_wander(cands, gusty)
         signature = _signature_ratios(cands, kin, p, aircraft, ic, mismatch, step)
         if plausible and not gusty:
@@ -168,7 +170,8 @@ def _air_share(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: Mod
     return air_share(-gust.w_fps / V0, slope, along.mismatch()["CZ"], nuisances, p.dt)
 
 
-def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: float) -> tuple[bool, bool, str]:
+def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: float,
+                 near: str = "") -> tuple[bool, bool, str]:
     """``(turbulent, light, gusty)`` once the air-share test has spoken.
 
     Turbulence stands only if the aerodynamics followed the vanes: an air share
@@ -176,10 +179,15 @@ def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: fl
     residual is vane error (a wandering vane at high speed reaches the gust level a
     turbulence finding needs), and the recording is then treated as gusty (no sensor value
     applied, none named). Light gusts (:func:`light_gusts`) are named light turbulence when
-    the share is at least :data:`AIR_SHARE_MIN` and :data:`AIR_T` standard errors above 0."""
+    the share is at least :data:`AIR_SHARE_MIN` and :data:`AIR_T` standard errors above 0;
+    so are gusts just under their angle (``near``: at :data:`LIGHT_TURBULENCE_FACTOR` times
+    the vanes' noise, no sensor value applied), which then void the sensor tests as light
+    gusts do; otherwise ``near`` changes nothing (the sensor tests stand there, as before)."""
     if air is None:
         return turbulent, False, gusty
     is_air = air.share >= AIR_SHARE_MIN and air.share >= AIR_T * air.std_error
+    if near:
+        return (False, True, near) if is_air else (turbulent, False, gusty)
     not_air = air.share + 2.0 * air.std_error < AIR_SHARE_MIN
     if not_air:
         sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
@@ -190,9 +198,10 @@ def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: fl
     return turbulent, bool(gusty) and is_air, gusty
 
 
-def vane_wander(air: AirShare | None) -> bool:
-    """Whether the air-share test put the vane-against-inertial difference on the vanes."""
-    return air is not None and air.share + 2.0 * air.std_error < AIR_SHARE_MIN
+def vane_wander(air: AirShare | None, gusty: str) -> bool:
+    """Whether the air-share test put a vane-against-inertial difference large enough to
+    void the sensor tests (``gusty``) on the vanes."""
+    return bool(gusty) and air is not None and air.share + 2.0 * air.std_error < AIR_SHARE_MIN
 
 
 def _withhold_vane_wander(cands: list[Candidate], why: str) -> None:
@@ -206,19 +215,19 @@ def _withhold_vane_wander(cands: list[Candidate], why: str) -> None:
             c.reason = f"not named: {why}"
 
 
-def light_gusts(gust, p: Prepared, V0: float) -> str:
+def light_gusts(gust, p: Prepared, V0: float, factor: float | None = None) -> str:
     """Why gusts too light to name as turbulence still leave the kinematic consistency the
     sensor tests rest on untrustworthy ('' when they do not): the kinematic residual stands
     :data:`GUST_RATIO` times above what sensor noise gives, and the gust angle it implies,
     σ/V, is at least :data:`GUST_ANGLE_FACTOR` times the white noise of the α and β vanes
-    (counted at no less than :data:`VANE_NOISE_FLOOR_RAD`). The same gust is a larger angle
+    (counted at no less than :data:`VANE_NOISE_FLOOR_RAD`; ``factor`` instead when given). The same gust is a larger angle
     the slower the aircraft: 1.9 ft/s at 180 ft/s is 0.6 deg, six times a 0.1 deg vane's
     noise, and there (Dryden severity 2) the kinematics named an α-vane skew and position on
     a c172x null, and an accelerometer 15 ft aft on a DHC-6 null (outside sweep, 2 Dec 2026)."""
     sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
     vane = max(float(np.mean([p.noise_std.get(c, 0.0) for c in ("alpha", "beta")])), VANE_NOISE_FLOOR_RAD)
     angle = sigma / max(V0, 1e-9)
-    if gust.ratio_to_noise < GUST_RATIO or angle < GUST_ANGLE_FACTOR * vane:
+    if gust.ratio_to_noise < GUST_RATIO or angle < (GUST_ANGLE_FACTOR if factor is None else factor) * vane:
         return ""
     return (f"gusts of about {sigma:.1f} ft/s ({np.degrees(angle):.2f} deg of angle at {V0:.0f} ft/s, "
             f"{angle / vane:.1f} times the vanes' noise; too light to name as turbulence) break the kinematic "
@@ -1200,6 +1209,10 @@ NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does n
 # -0.08 ± 0.03.
 AIR_SHARE_MIN = 0.5
 AIR_T = 4.0
+# Gusts this many times the vanes' noise (under GUST_ANGLE_FACTOR) are put to the air-share
+# test too, and named light turbulence only when it says air: Dryden severity 2 at 330 ft/s
+# stood at 2.49 times (air share 1.12 ± 0.14); no null without gusts reaches 1.7.
+LIGHT_TURBULENCE_FACTOR = 2.0
 
 
 def _practical_size(name: str, dt: float) -> float:

@@ -160,18 +160,20 @@ def round_significant(x: np.ndarray, digits: int = SIGNIFICANT_DIGITS) -> np.nda
     return np.array([float(fmt(v)) for v in np.asarray(x, dtype=float).tolist()])
 
 
-def flight_test_noise(white_scale: float = 1.0, gauss_markov_deg: float = 0.1) -> NoiseModel:
+def flight_test_noise(white_scale: float = 1.0, gauss_markov_deg: float = 0.1,
+                      gauss_markov_tau_s: float = 1.0) -> NoiseModel:
     """White noise at the ``white`` preset's levels (times ``white_scale``) on every channel,
-    and on α and β a first-order Gauss-Markov process besides (``gauss_markov_deg``, τ = 1 s):
+    and on α and β a first-order Gauss-Markov process besides (``gauss_markov_deg``, time
+    constant ``gauss_markov_tau_s``):
     vane and air-data errors that wander. No deliberate biases (a sensor bias is a concealed
     effect of its own)."""
     channels = {k: ChannelNoise(white_std=white_scale * v) for k, v in WHITE_LEVELS.items()}
     for k in ("alpha", "beta"):
         channels[k] = ChannelNoise(white_std=white_scale * WHITE_LEVELS[k], colored_std=gauss_markov_deg * DEG,
-                                   colored_tau_s=1.0)
+                                   colored_tau_s=gauss_markov_tau_s)
     return NoiseModel.build("flight-test", channels, source=(
         f"sidbench outside sweep: white preset levels x {white_scale:g}, Gauss-Markov {gauss_markov_deg:g} deg "
-        "(tau 1 s) on alpha and beta"), drop=("pdot", "qdot", "rdot"))
+        f"(tau {gauss_markov_tau_s:g} s) on alpha and beta"), drop=("pdot", "qdot", "rdot"))
 
 
 def _team_meta(meta: dict, data: pd.DataFrame, aircraft_label: str, maneuver: str) -> dict:
@@ -297,6 +299,7 @@ class Convention:
     rate_hz: float = 50.0          # sample rate
     white_scale: float = 1.0       # white noise, times the white preset's levels
     gauss_markov_deg: float = 0.1  # the α and β vanes' Gauss-Markov wander
+    gauss_markov_tau_s: float = 1.0  # and its time constant
     actuator_rps: float = 40.0     # the second-order actuators' natural frequency (ζ 0.7)
     duration_s: float = DURATION_S
     units: str = "canonical"       # or 'deg-kts': angles in deg, rates in deg/s, V in kts, h in m
@@ -308,6 +311,7 @@ class Convention:
         base = Convention()
         words = {"inputs": lambda v: v, "rate_hz": lambda v: f"{v:g} Hz", "white_scale": lambda v: f"noise x{v:g}",
                  "gauss_markov_deg": lambda v: f"vane wander {v:g} deg",
+                 "gauss_markov_tau_s": lambda v: f"wander tau {v:g} s",
                  "actuator_rps": lambda v: f"actuator {v:g} rad/s",
                  "duration_s": lambda v: f"{v:g} s", "units": lambda v: v,
                  "vanes_ft": lambda v: f"vanes {v:g} ft ahead",
@@ -509,6 +513,16 @@ def _convention_cases() -> list[OutsideCase]:
         # 3 ft/s a turbulence finding needs, at 180 ft/s the angle light gusts make
         ("H", "pitch", Convention(gauss_markov_deg=0.4), None),
         ("C1", "three_axis", Convention(gauss_markov_deg=0.4), None),
+        # the wander slower and faster than the usual 1 s: nearly a bias drifting over the
+        # record, or nearly white
+        ("S", "three_axis", Convention(gauss_markov_deg=0.2, gauss_markov_tau_s=5.0), None),
+        ("M", "lateral", Convention(gauss_markov_deg=0.2, gauss_markov_tau_s=5.0), None),
+        ("L", "pitch", Convention(gauss_markov_deg=0.15, gauss_markov_tau_s=10.0), None),
+        ("C1", "pitch", Convention(gauss_markov_deg=0.2, gauss_markov_tau_s=0.3), None),
+        ("S", "pitch", Convention(gauss_markov_deg=0.2, gauss_markov_tau_s=5.0),
+         (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
+        ("L", "lateral", Convention(gauss_markov_deg=0.2, gauss_markov_tau_s=5.0),
+         (H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r")),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):
@@ -576,7 +590,7 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
              "dhc6": "DHC-6 Twin Otter"}[cond.aircraft]
     paths, answers = {}, {}
     cv = c.convention
-    noise = flight_test_noise(cv.white_scale, cv.gauss_markov_deg)
+    noise = flight_test_noise(cv.white_scale, cv.gauss_markov_deg, cv.gauss_markov_tau_s)
     for i, (role, inp) in enumerate(zip(("identification", "validation"), maneuvers(c.kind, cond, cv.inputs))):
         flown = inp if c.clean else Actuated(inp, omega_rps=cv.actuator_rps)
         spec = FlightSpec(input=flown, aircraft=Aircraft(cond.model, hidden=c.effects), condition=cond.condition,

@@ -732,7 +732,7 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
     if a.gusty:
         out += [{"effect": e, "parameters": [], "reason": a.gusty}
                 for e in ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")]
-    if vane_wander(a.air):
+    if vane_wander(a.air, a.gusty):
         out.append({"effect": "coefficient_error", "parameters": ["terms in alpha, its powers and alphadot"],
                     "reason": a.gusty})
     out.append({"effect": "structural_mode", "parameters": [],
