@@ -523,6 +523,14 @@ def _convention_cases() -> list[OutsideCase]:
          (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
         ("L", "lateral", Convention(gauss_markov_deg=0.2, gauss_markov_tau_s=5.0),
          (H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r")),
+        # noisier instruments than the white preset's, on every kind of maneuver and aircraft
+        ("M", "three_axis", Convention(white_scale=3.0), None),
+        ("C1", "pitch", Convention(white_scale=2.0), None),
+        ("H", "lateral", Convention(white_scale=2.0), None),
+        ("D", "lateral", Convention(white_scale=2.0), None),
+        ("L", "pitch", Convention(white_scale=3.0, gauss_markov_deg=0.2), None),
+        ("H", "three_axis", Convention(white_scale=3.0), None),
+        ("S", "pitch", Convention(white_scale=3.0), (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):
