@@ -216,13 +216,13 @@ def _withhold_vane_wander(cands: list[Candidate], why: str) -> None:
 
 
 def light_gusts(gust, p: Prepared, V0: float, factor: float | None = None) -> str:
-    """Why gusts too light to name as turbulence still leave the kinematic consistency the
-    sensor tests rest on untrustworthy ('' when they do not): the kinematic residual stands
-    :data:`GUST_RATIO` times above what sensor noise gives, and the gust angle it implies,
-    σ/V, is at least :data:`GUST_ANGLE_FACTOR` times the white noise of the α and β vanes
-    (counted at no less than :data:`VANE_NOISE_FLOOR_RAD`; ``factor`` instead when given). The same gust is a larger angle
-    the slower the aircraft: 1.9 ft/s at 180 ft/s is 0.6 deg, six times a 0.1 deg vane's
-    noise, and there (Dryden severity 2) the kinematics named an α-vane skew and position on
+    """Why gusts under the :data:`GUST_MIN_FPS` of a turbulence finding still leave the
+    kinematic consistency the sensor tests rest on untrustworthy ('' when they do not): the
+    kinematic residual stands :data:`GUST_RATIO` times above what sensor noise gives, and
+    the gust angle it implies, σ/V, is at least :data:`GUST_ANGLE_FACTOR` (or ``factor``)
+    times the white noise of the α and β vanes (counted at no less than
+    :data:`VANE_NOISE_FLOOR_RAD`). The same gust is a larger angle the slower the aircraft:
+    1.9 ft/s at 180 ft/s is 0.6 deg, six times a 0.1 deg vane's noise, and there (Dryden severity 2) the kinematics named an α-vane skew and position on
     a c172x null, and an accelerometer 15 ft aft on a DHC-6 null (outside sweep, 2 Dec 2026)."""
     sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
     vane = max(float(np.mean([p.noise_std.get(c, 0.0) for c in ("alpha", "beta")])), VANE_NOISE_FLOOR_RAD)
@@ -230,8 +230,8 @@ def light_gusts(gust, p: Prepared, V0: float, factor: float | None = None) -> st
     if gust.ratio_to_noise < GUST_RATIO or angle < (GUST_ANGLE_FACTOR if factor is None else factor) * vane:
         return ""
     return (f"gusts of about {sigma:.1f} ft/s ({np.degrees(angle):.2f} deg of angle at {V0:.0f} ft/s, "
-            f"{angle / vane:.1f} times the vanes' noise; too light to name as turbulence) break the kinematic "
-            "consistency the sensor tests rest on")
+            f"{angle / vane:.1f} times the vanes' noise; under the {GUST_MIN_FPS:g} ft/s of turbulence) break the "
+            "kinematic consistency the sensor tests rest on")
 
 
 def _withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:

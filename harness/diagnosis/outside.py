@@ -530,7 +530,8 @@ def _convention_cases() -> list[OutsideCase]:
         ("D", "lateral", Convention(white_scale=2.0), None),
         ("L", "pitch", Convention(white_scale=3.0, gauss_markov_deg=0.2), None),
         ("H", "three_axis", Convention(white_scale=3.0), None),
-        ("S", "pitch", Convention(white_scale=3.0), (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
+        ("S", "pitch", Convention(white_scale=3.0),
+         (H("coefficient_error", -3.0, regressor="qhat"), "Cm_qhat", -3.0, "q")),
     ]
     out = []
     for i, (where, kind, cv, effect) in enumerate(spec):
