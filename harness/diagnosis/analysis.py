@@ -156,7 +156,8 @@ def _turbulence(p: Prepared):
     return gust, turbulent
 
 
-def _air_share(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, gust, V0: float) -> AirShare:
+def _air_share(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, gust,
+               V0: float) -> AirShare:
     """The air-share test (:func:`spectra.air_share`) on C_Z and the vertical gust, along
     the α vane's own record: where the maneuver did not drive α the model holds it at its
     start (:func:`model_states`), and is evaluated again along the vane for the test."""
@@ -175,7 +176,7 @@ def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: fl
     """``(turbulent, light, gusty)`` once the air-share test has spoken.
 
     Turbulence stands only if the aerodynamics followed the vanes: an air share
-    significantly under :data:`AIR_SHARE_MIN` (two standard errors) says the kinematic
+    significantly under :data:`AIR_SHARE_MIN` (:func:`_vane_error`) says the kinematic
     residual is vane error (a wandering vane at high speed reaches the gust level a
     turbulence finding needs), and the recording is then treated as gusty (no sensor value
     applied, none named). Light gusts (:func:`light_gusts`) are named light turbulence when
@@ -188,8 +189,7 @@ def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: fl
     is_air = air.share >= AIR_SHARE_MIN and air.share >= AIR_T * air.std_error
     if near:
         return (False, True, near) if is_air else (turbulent, False, gusty)
-    not_air = air.share + 2.0 * air.std_error < AIR_SHARE_MIN
-    if not_air:
+    if _vane_error(air):
         sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
         return False, False, (f"the vanes and the inertial channels disagree by {np.degrees(air.angle_rad):.2f} deg "
                               f"RMS ({sigma:.1f} ft/s at {V0:.0f} ft/s), but the aerodynamics did not follow the "
@@ -201,7 +201,12 @@ def gust_verdict(gust, air: AirShare | None, turbulent: bool, gusty: str, V0: fl
 def vane_wander(air: AirShare | None, gusty: str) -> bool:
     """Whether the air-share test put a vane-against-inertial difference large enough to
     void the sensor tests (``gusty``) on the vanes."""
-    return bool(gusty) and air is not None and air.share + 2.0 * air.std_error < AIR_SHARE_MIN
+    return bool(gusty) and air is not None and _vane_error(air)
+
+
+def _vane_error(air: AirShare) -> bool:
+    """The air share stands :data:`VANE_ERROR_Z` standard errors under :data:`AIR_SHARE_MIN`."""
+    return air.share + VANE_ERROR_Z * air.std_error < AIR_SHARE_MIN
 
 
 def _withhold_vane_wander(cands: list[Candidate], why: str) -> None:
@@ -222,8 +227,9 @@ def light_gusts(gust, p: Prepared, V0: float, factor: float | None = None) -> st
     the gust angle it implies, σ/V, is at least :data:`GUST_ANGLE_FACTOR` (or ``factor``)
     times the white noise of the α and β vanes (counted at no less than
     :data:`VANE_NOISE_FLOOR_RAD`). The same gust is a larger angle the slower the aircraft:
-    1.9 ft/s at 180 ft/s is 0.6 deg, six times a 0.1 deg vane's noise, and there (Dryden severity 2) the kinematics named an α-vane skew and position on
-    a c172x null, and an accelerometer 15 ft aft on a DHC-6 null (outside sweep, 2 Dec 2026)."""
+    1.9 ft/s at 180 ft/s is 0.6 deg, six times a 0.1 deg vane's noise, and there (Dryden
+    severity 2) the kinematics named an α-vane skew and position on a c172x null, and an
+    accelerometer 15 ft aft on a DHC-6 null (outside sweep, 2 Dec 2026)."""
     sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
     vane = max(float(np.mean([p.noise_std.get(c, 0.0) for c in ("alpha", "beta")])), VANE_NOISE_FLOOR_RAD)
     angle = sigma / max(V0, 1e-9)
@@ -1203,12 +1209,14 @@ GUST_ANGLE_FACTOR = 2.5
 VANE_NOISE_FLOOR_RAD = np.radians(0.1)
 NOT_IN_TURBULENCE = "not applied: in turbulence the kinematic consistency does not hold"
 # The air-share test (spectra.air_share): gusts are named when at least half the vane-vs-
-# inertial angle difference is air, AIR_T standard errors above none. Outside sweep (2 Dec
-# 2026): nulls 0.0-0.65 (k 0.35-1.16, the lowest on lateral maneuvers with little pitch);
-# Dryden severity 2 at 180-330 ft/s 0.9-1.1; severity 3-4 0.9-1.3; a 0.2 deg vane wander
-# -0.08 ± 0.03.
+# inertial angle difference is air, AIR_T standard errors above none; it is vane error when
+# the share stands VANE_ERROR_Z standard errors under the half. Outside sweep (2 Dec 2026):
+# pitch and three-axis nulls 0.0-0.65 (kinematic noise other than the vanes' puts it above
+# 0); Dryden severity 2 at 180-330 ft/s 0.96-1.12; severity 3-4 0.9-1.3; vane wander of
+# 0.2 deg at 700 ft/s -0.08 ± 0.03, of 0.4 deg 0.01 ± 0.02.
 AIR_SHARE_MIN = 0.5
 AIR_T = 4.0
+VANE_ERROR_Z = 2.0
 # Gusts this many times the vanes' noise (under GUST_ANGLE_FACTOR) are put to the air-share
 # test too, and named light turbulence only when it says air: Dryden severity 2 at 330 ft/s
 # stood at 2.49 times (air share 1.12 ± 0.14); no null without gusts reaches 1.7.

@@ -150,6 +150,7 @@ def _findings(analysis: Analysis) -> list[Candidate]:
 
 
 def _turbulence_rank(c: Candidate) -> int:
+    """0 for turbulence (it leads), 2 for light turbulence (it follows), 1 for the others."""
     if c.effect != "turbulence":
         return 1
     return 2 if c.details.get("light") else 0
