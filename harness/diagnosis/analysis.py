@@ -101,9 +101,10 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     along = model_along(p, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along
     mismatch = along.mismatch()
+    slope_of = _slope_function(aircraft, ic, states, surfaces, alphadot, aero)
     # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)
     near = near if not sensor_values else ""  # a corrected recording is not asked again
-    air = _air_share(p, aircraft, ic, along, gust, V0) if turbulent or gusty or near else None
+    air = _air_share(p, aircraft, ic, along, slope_of, gust, V0) if turbulent or gusty or near else None
     turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
     cands = _kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
     noise = coefficient_noise(p, mismatch)
@@ -116,7 +117,6 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     step = _stepwise(p, has_propeller(aircraft.model), aero, measured, mismatch, delays)
     cands += _aero_candidates(step.selections, delays, p.dt, step.shares)
     # the rules that keep a term from being named when something else would imitate it
-    slope_of = _slope_function(aircraft, ic, states, surfaces, alphadot, aero)
     _withhold_explained_by_cg(cands, step.selections, mismatch, p)
     _withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
     _withhold_ambiguous(cands, kin)
@@ -134,7 +134,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         if plausible and not gusty:
             _name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
             for vane in VANE_MEANS_AXES:
-                _name_vane_bias_from_means(cands, kin, p, aircraft, ic, step, vane, sensor_values.get(f"bias_{vane}", 0.0))
+                _name_vane_bias_from_means(cands, kin, p, aircraft, ic, step, vane,
+                                           sensor_values.get(f"bias_{vane}", 0.0))
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
     # 6. spectra and gusts
@@ -156,17 +157,16 @@ def _turbulence(p: Prepared):
     return gust, turbulent
 
 
-def _air_share(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, gust,
+def _air_share(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, slope_of, gust,
                V0: float) -> AirShare:
     """The air-share test (:func:`spectra.air_share`) on C_Z and the vertical gust, along
-    the α vane's own record: where the maneuver did not drive α the model holds it at its
-    start (:func:`model_states`), and is evaluated again along the vane for the test."""
+    the α vane's own record, with the model's C_Z,α from ``slope_of`` (:func:`_slope_function`
+    along ``along``): where the maneuver did not drive α the model holds it at its start
+    (:func:`model_states`), and is evaluated again along the vane for the test."""
     if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0:
         along = model_along(p, aircraft, ic, vanes=True)
-    states = dict(along.states)
-    states["alpha"] = np.asarray(states["alpha"], dtype=float) + rivals.SLOPE_STEP_RAD
-    moved = aero_along(aircraft, ic, states, along.surfaces, along.alphadot)
-    slope = (moved.coefficients["CZ"] - along.aero.coefficients["CZ"]) / rivals.SLOPE_STEP_RAD
+        slope_of = _slope_function(aircraft, ic, along.states, along.surfaces, along.alphadot, along.aero)
+    slope = slope_of("alpha")["CZ"]
     nuisances = [p.smooth[c] for c in ("alpha", "beta", "p", "q", "r") if c in p.smooth]
     return air_share(-gust.w_fps / V0, slope, along.mismatch()["CZ"], nuisances, p.dt)
 
