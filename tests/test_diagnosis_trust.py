@@ -408,3 +408,32 @@ def test_a_sensor_finding_the_validation_contradicts_says_what_the_same_test_gav
              "t": -162.9}
     text = _finding_dict(f, {}, {}, check)["explanation"]
     assert "the same test there gives -0.00698 ± 4.3e-05 rad, t = -162.9" in text
+
+
+def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
+    """analysis._withhold_ambiguous: a q-scale the kinematics suspect (t 2.6) withholds a
+    C_m,q̂ change only when, at a size they allow, it would imitate at least half of it
+    (``imitated``, analysis._imitation); a change far beyond that is kept, with the suspect
+    and its reach in ``details['sensor_suspect']``; where the imitation cannot be computed
+    the term stays withheld."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import IMITATION_SHARE, Candidate, _withhold_ambiguous
+    kin = SimpleNamespace(parameters={"scale_q": SimpleNamespace(channel="q")},
+                          selection=SimpleNamespace(params={}, terms=[SimpleNamespace(name="scale_q", estimate=-0.023,
+                                                                                      t=-2.6)]))
+
+    def term():
+        return Candidate("coefficient_error", "pitch", "Cm", "Cm_qhat", -6.85, 0.19, -30.5, 0.8, "per rad",
+                         "stepwise on the Cm mismatch", selected=True, reason="entered", details={"change": -5.9})
+
+    kept, withheld, unknown = term(), term(), term()
+    _withhold_ambiguous([kept], kin, lambda c, name: 0.05)
+    _withhold_ambiguous([withheld], kin, lambda c, name: IMITATION_SHARE * 5.9)
+    _withhold_ambiguous([unknown], kin, lambda c, name: None)
+    assert kept.selected and kept.details["sensor_suspect"] == {"parameter": "scale_q", "imitates_at_most": 0.05,
+                                                                "change": 5.9}
+    assert kept.reason == "entered; the kinematics suspect scale_q (t = 2.6), which would imitate at most 0.05 of " \
+        "this change of 5.9"
+    assert not withheld.selected and "scale_q, kinematic t = 2.6" in withheld.reason
+    assert not unknown.selected and unknown.details["sensor_rival"] == "scale_q"

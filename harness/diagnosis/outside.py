@@ -248,6 +248,12 @@ CONDITIONS = {c.key: c for c in (
               note="25,000 ft, 700 ft/s, alpha 2.5 deg; pitch-rate loop K = 0.3 s (open loop it diverges)"),
     Condition("C1", "c172x", "h=4000,V=180", 2.0, 5.0, 5.0, note="c172x, 4,000 ft, 180 ft/s, alpha 0.8 deg"),
     Condition("C2", "c172x", "h=8000,V=200", 2.0, 5.0, 5.0, note="c172x, 8,000 ft, 200 ft/s, alpha 0.6 deg"),
+    Condition("A", "f16", "h=20000,V=380", 2.0, 3.0, 3.0, note="20,000 ft, 380 ft/s, alpha 9.8 deg"),
+    Condition("Q", "f16", "h=5000,V=650", 1.0, 2.0, 2.0, 0.3,
+              note="5,000 ft, 650 ft/s, alpha 0.65 deg; pitch-rate loop K = 0.3 s"),
+    Condition("U", "f16", "h=25000,V=500", 1.5, 3.0, 3.0, note="25,000 ft, 500 ft/s, alpha 6.4 deg"),
+    Condition("C3", "c172x", "h=2000,V=150", 2.5, 5.0, 5.0, note="c172x, 2,000 ft, 150 ft/s, alpha 1.6 deg"),
+    Condition("C4", "c172x", "h=10000,V=170", 2.0, 5.0, 5.0, note="c172x, 10,000 ft, 170 ft/s, alpha 1.6 deg"),
     Condition("B", "737", "h=30000,V=750", 1.0, 3.0, 3.0, note="737 cruise, 30,000 ft, 750 ft/s"),
     Condition("D", "dhc6", "h=6000,V=230", 2.0, 2.0, 2.0,
               note="DHC-6 Twin Otter (two turboprops), 6,000 ft, 230 ft/s: a lateral input leaves it in a "
@@ -355,8 +361,9 @@ def _size_label(truth: float) -> str:
 
 
 def cases() -> tuple[OutsideCase, ...]:
-    """~75 cases: every effect id of effects.md over five F-16 conditions and two c172x
-    conditions, the three maneuver kinds, nulls of each kind on each aircraft, self-checks."""
+    """167 cases: every effect id of effects.md over five F-16 conditions and two c172x
+    conditions, the three maneuver kinds, nulls of each kind on each aircraft, self-checks;
+    then the DHC-6, the conventions, light gusts, the 737, and five more conditions."""
     spec = [
         # where, kind, effect, expect, parameter, truth, channel
         # --- F-16, pitch-only
@@ -444,6 +451,7 @@ def cases() -> tuple[OutsideCase, ...]:
     out += _convention_cases()
     out += _light_gust_cases()
     out += _airliner_cases()
+    out += _more_condition_cases()
     for where in ("S", "B", "C1", "D"):
         out.append(OutsideCase(f"selfcheck_{CONDITIONS[where].aircraft}_{where}", where, "three_axis", clean=True,
                                self_check=True))
@@ -562,6 +570,25 @@ def _airliner_cases() -> list[OutsideCase]:
     out += [OutsideCase(f"B_{kind}_none_s{95 + i}", "B", kind, seed=95 + i)
             for i, kind in enumerate(("pitch", "lateral", "three_axis"))]
     return [replace(c, drop=_drops(i)) for i, c in enumerate(out)]
+
+
+def _more_condition_cases() -> list[OutsideCase]:
+    """Five more conditions (F-16 at 20,000 ft and 380 ft/s, alpha 9.8 deg; at 5,000 ft and
+    650 ft/s; at 25,000 ft and 500 ft/s; the c172x at 2,000 and 10,000 ft): a null of each kind
+    at each, and one effect at four of them (their own seeds and drops, so the other cases
+    stay as they were)."""
+    out = []
+    for i, where in enumerate(("A", "Q", "U", "C3", "C4")):
+        out += [OutsideCase(f"{where}_{kind}_none_s{501 + 3 * i + j}", where, kind, seed=501 + 3 * i + j)
+                for j, kind in enumerate(KINDS)]
+    spec = [("A", "pitch", H("coefficient_error", -6.0, regressor="qhat"), "Cm_qhat", -6.0, "q"),
+            ("U", "lateral", H("coefficient_error", 0.03, coefficient="Cn", regressor="beta"), "Cn_beta", 0.03, "r"),
+            ("C3", "pitch", H("control_delay", 0.08, surface="de"), "tau_de", 0.08, "q"),
+            ("C4", "lateral", H("coefficient_error", -0.02, coefficient="Cl", regressor="beta"), "Cl_beta", -0.02,
+             "p")]
+    out += [OutsideCase(f"{where}_{kind}_{e.effect}_{param}_{_size_label(truth)}", where, kind, (e,), e.effect, param,
+                        truth, ch, seed=600 + i) for i, (where, kind, e, param, truth, ch) in enumerate(spec)]
+    return [replace(c, drop=_drops(c.seed)) for c in out]
 
 
 def _light_gust_cases() -> list[OutsideCase]:
