@@ -356,3 +356,21 @@ def test_vanes_wandering_as_far_as_gusts_are_not_turbulence(tmp_path):
     assert gust["estimate"] >= 3.0 and not gust["selected"] and share < 0.25
     assert any("vane error, not turbulence" in x["reason"] and x["effect"] == "coefficient_error"
                for x in result["not_checked"])
+
+
+def test_a_c172x_alpha_vane_bias_is_named_from_the_longitudinal_coefficient_means(tmp_path):
+    """Outside case C1_pitch (1° α-vane bias, c172x at 180 ft/s): the kinematics hardly see
+    it (t 1.4); the means of C_X, C_Z and C_m along the vane are off by the model's own slopes
+    times one constant (analysis._name_vane_bias_from_means, offered for α as for β), and
+    the validation maneuver shows it too. Size within 2 standard errors or 5 %."""
+    import math
+
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "C1_pitch_sensor_bias_bias_alpha_0.0174533")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
+    f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
+    assert f["evidence"]["test"] == "longitudinal coefficient means along the α vane"
+    assert set(f["evidence"]["vane_means"]["axes"]) == {"CX", "CZ", "Cm"}
+    assert abs(f["estimate"] - math.radians(1.0)) <= max(2 * f["std_error"], 0.05 * math.radians(1.0))
+    assert f["evidence"]["validation"]["status"] == "confirmed"
