@@ -437,3 +437,30 @@ def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
         "this change of 5.9"
     assert not withheld.selected and "scale_q, kinematic t = 2.6" in withheld.reason
     assert not unknown.selected and unknown.details["sensor_rival"] == "scale_q"
+
+
+def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the_mismatch(monkeypatch):
+    """analysis._vane_noise_columns: the column −C_m,α·e (e = −w_gust/V from the kinematic
+    residual) is offered to C_m's fit when, fitted alone, it takes at least VANE_NOISE_SHARE
+    off the mismatch RMS (a mismatch that is mostly the vane's error passed through C_m,α),
+    not when the mismatch is something else, nor when α is held at its start."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis import analysis
+    rng = np.random.default_rng(7)
+    n, V0 = 1500, 180.0
+    w = rng.standard_normal(n)                        # the "gust": V times the vane-minus-inertial angle
+    monkeypatch.setattr(analysis, "_turbulence", lambda p: (SimpleNamespace(w_fps=w), False))
+    p = SimpleNamespace(dt=0.02, n=n)
+    along = SimpleNamespace(states={"alpha": np.linspace(0.0, 0.02, n)})
+    slope = np.full(n, -1.2)
+    column = slope * w / V0                            # −C_m,α·e with e = −w/V
+    vane_made = {"Cm": 0.9 * column + 0.3 * np.std(column) * rng.standard_normal(n)}
+    other = {"Cm": np.std(column) * rng.standard_normal(n)}
+    got = analysis._vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, vane_made)
+    assert set(got) == {"Cm"} and np.allclose(got["Cm"], column)
+    assert analysis._vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, other) == {}
+    held = SimpleNamespace(states={"alpha": np.zeros(n)})
+    assert analysis._vane_noise_columns(p, held, lambda x: {"Cm": slope}, V0, vane_made) == {}

@@ -114,7 +114,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     cands.append(off_candidate)
     # 4. delay scans; 5. per-axis stepwise
     delays = _delay_scans(p, mismatch, aero, noise)
-    step = _stepwise(p, has_propeller(aircraft.model), aero, measured, mismatch, delays)
+    vane = _vane_noise_columns(p, along, slope_of, V0, mismatch)
+    step = _stepwise(p, has_propeller(aircraft.model), aero, measured, mismatch, delays, vane)
     cands += _aero_candidates(step.selections, delays, p.dt, step.shares)
     # the rules that keep a term from being named when something else would imitate it
     _withhold_explained_by_cg(cands, step.selections, mismatch, p)
@@ -443,11 +444,51 @@ class _Stepwise:
     shares: dict            # (axis, key) -> share of the coefficient's excursion
 
 
+# The α vane's noise column enters C_m's fit where it is a material part of the mismatch:
+# fitted alone (with a constant) it takes at least this share off C_m's mismatch RMS.
+VANE_NOISE_SHARE = 0.15
+
+
+def _vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float,
+                        mismatch: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The column −C_m,α·e that the α vane's own error passes into C_m's mismatch, e the
+    vane's angle less the one the inertial channels integrate to (the kinematic residual's
+    vertical "gust" over the airspeed, high-passed at :data:`spectra.GUST_HIGHPASS_HZ`); empty
+    when the model is not evaluated along the vane (α held at its start) or when the column
+    takes less than :data:`VANE_NOISE_SHARE` off C_m's mismatch RMS.
+
+    The model evaluated along the vane passes the vane's error through its slopes (errors in
+    variables); a Gauss-Markov wander is in the maneuver's band and survives the smoother. On a
+    slow aircraft that is a large part of C_m's mismatch: on the outside sweep's c172x nulls at
+    180 and 200 ft/s (0.1° white plus 0.1° wander at τ = 1 s) the column alone took 29-35 %
+    off it, on the F-16 0-6 %. With it, the c172x's C_m ΔV/V drift of 0.02 is named (0.0212;
+    missed before) and no other case of either sweep changed. Always in the fit it also named
+    the c172x's 0.25 ft moment-reference shift (its column takes 13 %) but drew a C_m α³ in
+    place of the DHC-6's 0.5 ft shift (5 %), hence the gate. Only C_m: the same column took
+    40-50 % off C_Z's mismatch, and the cleaner C_Z showed a C_Z ΔV/V on F-16 nulls at 550
+    and 700 ft/s and a C_Z,α̇ where a_z lagged (false findings). In gusts e is air, which the
+    aerodynamics followed: the column then fits nothing (the air-share test,
+    :func:`spectra.air_share`, is this fit on C_Z)."""
+    if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0:
+        return {}
+    gust, _ = _turbulence(p)
+    if gust.w_fps is None:
+        return {}
+    column = slope_of("alpha")["Cm"] * np.asarray(gust.w_fps, dtype=float) / V0   # −C_m,α·e, e = −w/V
+    inner = _inner(p)
+    z = mismatch["Cm"][inner]
+    A = np.column_stack([column[inner], np.ones(z.size)])
+    left = z - A @ np.linalg.lstsq(A, z, rcond=None)[0]
+    share = 1.0 - float(np.std(left)) / max(float(np.std(z)), 1e-300)
+    return {"Cm": column} if share >= VANE_NOISE_SHARE else {}
+
+
 def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str, np.ndarray],
-              mismatch: dict[str, np.ndarray], delays: dict) -> _Stepwise:
+              mismatch: dict[str, np.ndarray], delays: dict, vane: dict[str, np.ndarray] | None = None) -> _Stepwise:
     """Per-axis colored forward selection over the offered candidate terms (and the delay
-    columns), with the thrust nuisance where thrust was not recorded; drift terms that thrust
-    or a propeller would imitate are not offered."""
+    columns), with the thrust nuisance where thrust was not recorded and the α vane's noise
+    column (:func:`_vane_noise_columns`) where the model follows the vane; drift terms that
+    thrust or a propeller would imitate are not offered."""
     selections, nuisances, not_offered, shares = {}, {}, {}, {}
     inner = _inner(p)
     for axis in COEFFICIENTS:
@@ -456,6 +497,8 @@ def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str,
                              | ({"reason": t.details["not_offered"]} if "not_offered" in t.details else {})
                              for t in skipped]
         nuisance = _thrust_nuisance(p, axis, terms)
+        if vane and axis in vane:
+            nuisance["vane_alpha_noise"] = vane[axis]
         why = NO_THRUST_DRIFT if "thrust_dV" in nuisance else PROPELLER_DRIFT if (axis in cand.LAT and propeller) \
             else None
         if why:
