@@ -114,7 +114,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     cands.append(off_candidate)
     # 4. delay scans; 5. per-axis stepwise
     delays = _delay_scans(p, mismatch, aero, noise)
-    vane = _vane_noise_columns(p, along, slope_of, V0, mismatch)
+    vane = _vane_noise_columns(p, along, slope_of, V0, mismatch, None if sensor_values else gust)
     step = _stepwise(p, has_propeller(aircraft.model), aero, measured, mismatch, delays, vane)
     cands += _aero_candidates(step.selections, delays, p.dt, step.shares)
     # the rules that keep a term from being named when something else would imitate it
@@ -449,13 +449,14 @@ class _Stepwise:
 VANE_NOISE_SHARE = 0.15
 
 
-def _vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float,
-                        mismatch: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def _vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mismatch: dict[str, np.ndarray],
+                        gust=None) -> dict[str, np.ndarray]:
     """The column −C_m,α·e that the α vane's own error passes into C_m's mismatch, e the
     vane's angle less the one the inertial channels integrate to (the kinematic residual's
     vertical "gust" over the airspeed, high-passed at :data:`spectra.GUST_HIGHPASS_HZ`); empty
     when the model is not evaluated along the vane (α held at its start) or when the column
-    takes less than :data:`VANE_NOISE_SHARE` off C_m's mismatch RMS.
+    takes less than :data:`VANE_NOISE_SHARE` off C_m's mismatch RMS. ``gust`` is the gust
+    estimate already made from these channels; None makes it again (after sensor corrections).
 
     The model evaluated along the vane passes the vane's error through its slopes (errors in
     variables); a Gauss-Markov wander is in the maneuver's band and survives the smoother. On a
@@ -471,7 +472,8 @@ def _vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float,
     :func:`spectra.air_share`, is this fit on C_Z)."""
     if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0:
         return {}
-    gust, _ = _turbulence(p)
+    if gust is None:
+        gust, _ = _turbulence(p)
     if gust.w_fps is None:
         return {}
     column = slope_of("alpha")["Cm"] * np.asarray(gust.w_fps, dtype=float) / V0   # −C_m,α·e, e = −w/V
