@@ -464,3 +464,36 @@ def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the
     assert analysis._vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, other) == {}
     held = SimpleNamespace(states={"alpha": np.zeros(n)})
     assert analysis._vane_noise_columns(p, held, lambda x: {"Cm": slope}, V0, vane_made) == {}
+
+
+def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
+    """analysis._cg_refuted_by_mean: a shift Δx moves C_m by Δx·C_Z/c̄, its mean too. The
+    shift a lateral C_n fit suggests (C_n ∝ C_Y looks like C_n,β) is refuted when C_m's
+    constant falls short of Δx·mean(C_Z)/c̄ by more than CG_MEAN_SHARE of it and CG_MEAN_Z
+    standard errors; the recorded mistrim, or a larger one of the same sign, supports it."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.analysis import CG_MEAN_SHARE, _cg_refuted_by_mean
+    rng = np.random.default_rng(3)
+    n, cbar, b, dx = 1500, 11.32, 30.0, 0.6
+    CZ = -0.5 + 0.01 * np.sin(np.linspace(0.0, 20.0, n))
+    CY = 0.02 * np.sin(np.linspace(0.0, 13.0, n))
+    p = SimpleNamespace(dt=0.02, n=n, meta={"geometry": {"cbar_ft": cbar, "b_ft": b}})
+    inner = slice(50, n - 50)
+    predicted = dx * float(np.mean(CZ[inner])) / cbar          # about −0.027
+    cm_sel = SimpleNamespace(names=(), params={})
+    cn_sel = SimpleNamespace(names=("cg",), params={"cg": dx / -b})
+    selections = {"Cm": (cm_sel, {}), "Cn": (cn_sel, {"cg": SimpleNamespace(scale=-b, column=CY)})}
+    noise = 1e-4 * rng.standard_normal(n)
+
+    def verdict(cm_constant):
+        mismatch = {"Cm": cm_constant + noise, "Cn": -dx / b * CY + noise}
+        return _cg_refuted_by_mean(p, "Cn", selections, {}, mismatch, {"CZ": CZ, "CY": CY})
+
+    assert "refuted by the mean of C_m" in verdict(0.0)                       # no mistrim at all
+    assert "refuted" in verdict((1.0 - CG_MEAN_SHARE) * predicted * 0.5)   # far short of it
+    assert verdict(predicted) is None                                        # the shift's own mistrim
+    assert verdict(1.6 * predicted) is None                                  # a larger one supports it
+    assert _cg_refuted_by_mean(p, "Cm", selections, {}, {"Cm": noise}, {"CZ": CZ}) is None  # no shift entered

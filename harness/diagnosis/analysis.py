@@ -491,7 +491,7 @@ def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str,
     columns), with the thrust nuisance where thrust was not recorded and the α vane's noise
     column (:func:`_vane_noise_columns`) where the model follows the vane; drift terms that
     thrust or a propeller would imitate are not offered."""
-    selections, nuisances, not_offered, shares = {}, {}, {}, {}
+    selections, nuisances, not_offered, shares, pools = {}, {}, {}, {}, {}
     inner = _inner(p)
     for axis in COEFFICIENTS:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
@@ -508,14 +508,72 @@ def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str,
                                    "reason": why} for t in terms if t.key == "dV"]
             terms = [t for t in terms if t.key != "dV"]
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
-        sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra, forced=nuisance)
-        by_key = {t.key: t for t in terms}
-        for t in sel.terms:
-            column = by_key[t.name].column if t.name in by_key else extra[t.name]
-            shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
-        selections[axis] = (sel, by_key)
+        pools[axis] = (terms, extra)
+        selections[axis] = _select(p, axis, mismatch, terms, extra, nuisance, measured, shares)
         nuisances[axis] = nuisance
+    for axis in ("Cm", "Cn"):  # C_m first: the test of either axis's shift is C_m's constant
+        refuted = _cg_refuted_by_mean(p, axis, selections, nuisances, mismatch, measured)
+        if refuted is None:
+            continue
+        terms, extra = pools[axis]
+        terms = [t for t in terms if t.effect != "cg_offset"]
+        shares = {k: v for k, v in shares.items() if k[0] != axis}
+        selections[axis] = _select(p, axis, mismatch, terms, extra, nuisances[axis], measured, shares)
+        not_offered[axis].append({"effect": "cg_offset", "parameter": "dx_moment_reference", "sources": ["alpha"],
+                                  "reason": refuted})
     return _Stepwise(selections, nuisances, not_offered, shares)
+
+
+def _select(p: Prepared, axis: str, mismatch: dict[str, np.ndarray], terms: list, extra: dict,
+            nuisance: dict, measured: dict[str, np.ndarray], shares: dict) -> tuple:
+    """One axis's stepwise (:func:`candidates.axis_selection`), each term's share of the
+    coefficient's excursion put in ``shares``; returns ``(selection, {key: Term})``."""
+    inner = _inner(p)
+    sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra, forced=nuisance)
+    by_key = {t.key: t for t in terms}
+    for t in sel.terms:
+        column = by_key[t.name].column if t.name in by_key else extra[t.name]
+        shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
+    return sel, by_key
+
+
+# A moment-reference shift Δx moves C_m by Δx·C_Z/c̄ (effects.md), so also its mean: C_Z
+# is about −C_L at trim, never near zero in level flight, and the shift mistrims the model by
+# Δx·mean(C_Z)/c̄. On the outside sweep's 11 shifts (0.25–1 ft, F-16, c172x, DHC-6) C_m's
+# mismatch mean was that to within 8 %; on its nulls it stayed under 0.006. A shift whose
+# predicted mean C_m the recording's falls short of by more than this share of the
+# prediction and :data:`CG_MEAN_Z` standard errors is refuted.
+CG_MEAN_SHARE = 0.5
+CG_MEAN_Z = 3.0
+
+
+def _cg_refuted_by_mean(p: Prepared, axis: str, selections: dict, nuisances: dict,
+                        mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> str | None:
+    """Why the moment-reference shift ``axis``'s stepwise entered is refuted by the mean of
+    C_m's mismatch (None when it entered nowhere or agrees): the shift Δx predicts a constant
+    Δx·mean(C_Z)/c̄ in C_m beside C_m's other entered terms (a colored-residual fit with a
+    constant, Eq. 5's standard errors); a shift read off C_n's C_Y column alone on a lateral
+    maneuver is otherwise indistinguishable from C_n,β."""
+    sel, by_key = selections[axis]
+    if "cg" not in sel.names:
+        return None
+    term = by_key["cg"]
+    dx = sel.params["cg"] * term.scale
+    inner = _inner(p)
+    cbar = p.meta["geometry"]["cbar_ft"]
+    predicted = dx * float(np.mean(measured["CZ"][inner])) / cbar
+    cm_sel, cm_terms = selections["Cm"]
+    cols = [cm_terms[k].column[inner] for k in cm_sel.names if k in cm_terms and k != "cg"]
+    cols += [c[inner] for c in nuisances.get("Cm", {}).values() if np.ptp(c[inner]) > 0]
+    theta, se, _ = colored_fit(mismatch["Cm"][inner], cols, [f"x{i}" for i in range(len(cols))])
+    mean, mean_se = float(theta[-1]), float(se[-1])
+    # only a mistrim short of the prediction refutes: one beyond it (a larger shift, which the
+    # other entered terms shared out) supports the shift
+    short = abs(predicted) - mean * np.sign(predicted)
+    if short <= CG_MEAN_SHARE * abs(predicted) or short <= CG_MEAN_Z * mean_se:
+        return None
+    return (f"refuted by the mean of C_m: the shift of {dx:.3g} ft the {axis} mismatch suggests would mistrim "
+            f"C_m by {predicted:+.2g}; C_m's mismatch has a constant of {mean:+.2g} ± {mean_se:.1g}")
 
 
 def _slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],
