@@ -467,15 +467,16 @@ def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the
 
 
 def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
-    """analysis._cg_refuted_by_mean: a shift Δx moves C_m by Δx·C_Z/c̄, its mean too. The
-    shift a lateral C_n fit suggests (C_n ∝ C_Y looks like C_n,β) is refuted when C_m's
-    constant falls short of Δx·mean(C_Z)/c̄ by more than CG_MEAN_SHARE of it and CG_MEAN_Z
-    standard errors; the recorded mistrim, or a larger one of the same sign, supports it."""
+    """analysis._cg_mean_test: a shift Δx moves C_m by Δx·C_Z/c̄, its mean too. The shift a
+    lateral C_n fit suggests (C_n ∝ C_Y looks like C_n,β) is refuted when C_m's constant
+    falls short of Δx·mean(C_Z)/c̄ by more than CG_MEAN_SHARE of it and CG_MEAN_Z standard
+    errors; the shift's own mistrim, or a larger one of the same sign, supports it. A short
+    constant that is itself a shift of the same sign is that shift, pinned (c̄·constant/mean C_Z)."""
     from types import SimpleNamespace
 
     import numpy as np
 
-    from harness.diagnosis.analysis import CG_MEAN_SHARE, _cg_refuted_by_mean
+    from harness.diagnosis.analysis import CG_MEAN_SHARE, _cg_mean_test
     rng = np.random.default_rng(3)
     n, cbar, b, dx = 1500, 11.32, 30.0, 0.6
     CZ = -0.5 + 0.01 * np.sin(np.linspace(0.0, 20.0, n))
@@ -487,13 +488,18 @@ def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
     cn_sel = SimpleNamespace(names=("cg",), params={"cg": dx / -b})
     selections = {"Cm": (cm_sel, {}), "Cn": (cn_sel, {"cg": SimpleNamespace(scale=-b, column=CY)})}
     noise = 1e-4 * rng.standard_normal(n)
+    measured = {"CZ": CZ, "CY": CY, "Cm": 0.01 * np.sin(np.linspace(0.0, 9.0, n))}
 
     def verdict(cm_constant):
         mismatch = {"Cm": cm_constant + noise, "Cn": -dx / b * CY + noise}
-        return _cg_refuted_by_mean(p, "Cn", selections, {}, mismatch, {"CZ": CZ, "CY": CY})
+        return _cg_mean_test(p, "Cn", selections, {}, mismatch, measured)
 
-    assert "refuted by the mean of C_m" in verdict(0.0)                       # no mistrim at all
-    assert "refuted" in verdict((1.0 - CG_MEAN_SHARE) * predicted * 0.5)   # far short of it
-    assert verdict(predicted) is None                                        # the shift's own mistrim
-    assert verdict(1.6 * predicted) is None                                  # a larger one supports it
-    assert _cg_refuted_by_mean(p, "Cm", selections, {}, {"Cm": noise}, {"CZ": CZ}) is None  # no shift entered
+    none = verdict(0.0)                                                      # no mistrim at all
+    assert none.refuted and not none.pinned and "refuted by the mean of C_m" in none.reason
+    short = verdict(0.25 * (1.0 - CG_MEAN_SHARE) * predicted)               # far short, same sign
+    assert short.refuted and short.pinned and "named instead" in short.reason
+    assert abs(short.dx_ft - 0.25 * (1.0 - CG_MEAN_SHARE) * dx) < 5 * short.std_error_ft + 1e-3
+    assert not verdict(-predicted).pinned                                    # the other sign: refuted only
+    assert not verdict(predicted).refuted                                    # the shift's own mistrim
+    assert not verdict(1.6 * predicted).refuted                              # a larger one supports it
+    assert _cg_mean_test(p, "Cm", selections, {}, {"Cm": noise}, measured) is None  # no shift entered

@@ -117,6 +117,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     vane = _vane_noise_columns(p, along, slope_of, V0, mismatch, None if sensor_values else gust)
     step = _stepwise(p, has_propeller(aircraft.model), aero, measured, mismatch, delays, vane)
     cands += _aero_candidates(step.selections, delays, p.dt, step.shares)
+    if step.pinned is not None:
+        cands.append(_pinned_shift(step.pinned))
     # the rules that keep a term from being named when something else would imitate it
     _withhold_explained_by_cg(cands, step.selections, mismatch, p)
     _withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
@@ -442,6 +444,7 @@ class _Stepwise:
     nuisances: dict         # axis -> {name: column} always in the fit
     not_offered: dict       # axis -> terms not offered, with the reason
     shares: dict            # (axis, key) -> share of the coefficient's excursion
+    pinned: CgMeanTest | None = None  # a moment-reference shift sized by C_m's mistrim
 
 
 # The α vane's noise column enters C_m's fit where it is a material part of the mismatch:
@@ -511,17 +514,48 @@ def _stepwise(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str,
         pools[axis] = (terms, extra)
         selections[axis] = _select(p, axis, mismatch, terms, extra, nuisance, measured, shares)
         nuisances[axis] = nuisance
+    pinned = None
     for axis in ("Cm", "Cn"):  # C_m first: the test of either axis's shift is C_m's constant
-        refuted = _cg_refuted_by_mean(p, axis, selections, nuisances, mismatch, measured)
-        if refuted is None:
+        test = _cg_mean_test(p, axis, selections, nuisances, mismatch, measured)
+        if test is None or not test.refuted:
             continue
-        terms, extra = pools[axis]
-        terms = [t for t in terms if t.effect != "cg_offset"]
-        shares = {k: v for k, v in shares.items() if k[0] != axis}
-        selections[axis] = _select(p, axis, mismatch, terms, extra, nuisances[axis], measured, shares)
+        refit = (axis,)
+        if test.pinned and pinned is None:
+            # the shift the mistrim itself says: both its axes refitted with it taken out
+            pinned, refit = test, ("Cm", "Cn")
+            mismatch = _without_shift(p, mismatch, measured, test.dx_ft)
+        for a in refit:
+            terms, extra = pools[a]
+            terms = [t for t in terms if t.effect != "cg_offset"]
+            shares = {k: v for k, v in shares.items() if k[0] != a}
+            selections[a] = _select(p, a, mismatch, terms, extra, nuisances[a], measured, shares)
+            pools[a] = (terms, extra)
         not_offered[axis].append({"effect": "cg_offset", "parameter": "dx_moment_reference", "sources": ["alpha"],
-                                  "reason": refuted})
-    return _Stepwise(selections, nuisances, not_offered, shares)
+                                  "reason": test.reason})
+    return _Stepwise(selections, nuisances, not_offered, shares, pinned)
+
+
+def _pinned_shift(test: CgMeanTest) -> Candidate:
+    """The moment-reference shift C_m's mistrim says (:func:`_cg_mean_test`), a candidate
+    named when significant (the entry t) and practical (the mistrim at least
+    :data:`candidates.PRACTICAL_SHARE` of C_m's excursion)."""
+    t = test.dx_ft / test.std_error_ft if test.std_error_ft > 0 else 0.0
+    sel = abs(t) >= cand.T_IN and _practical(test.share)
+    return Candidate("cg_offset", cand.AXIS_NAME["Cm"], "Cm", "dx_moment_reference", test.dx_ft, test.std_error_ft,
+                     t, 0.0, "ft", "the mistrim of C_m (its constant over the mean of C_Z)", sel,
+                     "entered" if sel else ("not entered" if abs(t) < cand.T_IN else _impractical_reason(test.share)),
+                     {"mistrim_share": test.share})
+
+
+def _without_shift(p: Prepared, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray],
+                   dx_ft: float) -> dict[str, np.ndarray]:
+    """The mismatch less what a moment-reference shift of ``dx_ft`` puts in it: Δx·C_Z/c̄ in
+    C_m and −Δx·C_Y/b in C_n (effects.md's cg_offset)."""
+    geo = p.meta["geometry"]
+    out = dict(mismatch)
+    out["Cm"] = mismatch["Cm"] - dx_ft / geo["cbar_ft"] * measured["CZ"]
+    out["Cn"] = mismatch["Cn"] + dx_ft / geo["b_ft"] * measured["CY"]
+    return out
 
 
 def _select(p: Prepared, axis: str, mismatch: dict[str, np.ndarray], terms: list, extra: dict,
@@ -547,13 +581,27 @@ CG_MEAN_SHARE = 0.5
 CG_MEAN_Z = 3.0
 
 
-def _cg_refuted_by_mean(p: Prepared, axis: str, selections: dict, nuisances: dict,
-                        mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> str | None:
-    """Why the moment-reference shift ``axis``'s stepwise entered is refuted by the mean of
-    C_m's mismatch (None when it entered nowhere or agrees): the shift Δx predicts a constant
+class CgMeanTest(NamedTuple):
+    """A moment-reference shift the stepwise entered, against the mistrim of C_m."""
+
+    refuted: bool     # the recorded mistrim falls short of the one the shift predicts
+    reason: str
+    dx_ft: float      # the shift the mistrim itself says, Δx = c̄·constant/mean(C_Z)
+    std_error_ft: float
+    pinned: bool      # refuted, yet the mistrim itself is a shift of the same sign (CG_MEAN_Z)
+    share: float      # the mistrim over C_m's excursion (its practical size)
+
+
+def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
+                  mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> CgMeanTest | None:
+    """The moment-reference shift ``axis``'s stepwise entered, tested against the mean of
+    C_m's mismatch (None when none entered): the shift Δx predicts a constant
     Δx·mean(C_Z)/c̄ in C_m beside C_m's other entered terms (a colored-residual fit with a
     constant, Eq. 5's standard errors); a shift read off C_n's C_Y column alone on a lateral
-    maneuver is otherwise indistinguishable from C_n,β."""
+    maneuver is otherwise indistinguishable from C_n,β. Refuted when the constant falls
+    short of the prediction; then, if the constant is itself a shift of the prediction's sign
+    (:data:`CG_MEAN_Z` standard errors from zero), that shift is the one to name: the stepwise
+    shared the C_Z column with terms that follow α (C_Z does), oversizing it."""
     sel, by_key = selections[axis]
     if "cg" not in sel.names:
         return None
@@ -570,10 +618,17 @@ def _cg_refuted_by_mean(p: Prepared, axis: str, selections: dict, nuisances: dic
     # only a mistrim short of the prediction refutes: one beyond it (a larger shift, which the
     # other entered terms shared out) supports the shift
     short = abs(predicted) - mean * np.sign(predicted)
+    cz = float(np.mean(measured["CZ"][inner]))
+    dx_mean, se_mean = mean * cbar / cz, mean_se * cbar / abs(cz)
+    share = abs(mean) / max(float(np.std(measured["Cm"][inner])), 1e-300)
     if short <= CG_MEAN_SHARE * abs(predicted) or short <= CG_MEAN_Z * mean_se:
-        return None
-    return (f"refuted by the mean of C_m: the shift of {dx:.3g} ft the {axis} mismatch suggests would mistrim "
-            f"C_m by {predicted:+.2g}; C_m's mismatch has a constant of {mean:+.2g} ± {mean_se:.1g}")
+        return CgMeanTest(False, "", dx_mean, se_mean, False, share)
+    pinned = mean * np.sign(predicted) >= CG_MEAN_Z * mean_se
+    reason = (f"refuted by the mean of C_m: the shift of {dx:.3g} ft the {axis} mismatch suggests would mistrim "
+              f"C_m by {predicted:+.2g}; C_m's mismatch has a constant of {mean:+.2g} ± {mean_se:.1g}")
+    if pinned:
+        reason += f", the mistrim of a {dx_mean:.3g} ± {se_mean:.2g} ft shift, named instead"
+    return CgMeanTest(True, reason, dx_mean, se_mean, bool(pinned), share)
 
 
 def _slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],
