@@ -503,3 +503,33 @@ def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
     assert not verdict(predicted).refuted                                    # the shift's own mistrim
     assert not verdict(1.6 * predicted).refuted                              # a larger one supports it
     assert _cg_mean_test(p, "Cm", selections, {}, {"Cm": noise}, measured) is None  # no shift entered
+
+
+def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematics():
+    """run._vane_means_check: where the validation maneuver's kinematics gave the vane bias
+    themselves (so its coefficient-means test did not run), their estimate decides as for any
+    sensor finding: the same sign at |t| >= SENSOR_CONFIRM_T confirms, the opposite sign at
+    that |t| contradicts, a weaker one is neutral; not when they also name a scale of that
+    vane, which reads as a bias at the trim α."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.run import SENSOR_CONFIRM_T, _vane_means_check
+    named = Candidate("sensor_bias", "lon", "alpha", "bias_alpha", 0.0173, 0.0006, 28.0, 0.0, "rad",
+                      "longitudinal coefficient means along the α vane", True)
+
+    def twin(estimate, t, test="kinematic consistency (bias always fitted)", details=None):
+        c = Candidate("sensor_bias", "lon", "alpha", "bias_alpha", estimate, abs(estimate / t), t, 0.0, "rad", test,
+                      True, details=details or {})
+        return SimpleNamespace(candidates=[c])
+
+    assert _vane_means_check(twin(0.0209, 5.25), named)["status"] == "confirmed"
+    assert _vane_means_check(twin(-0.0209, -5.25), named)["status"] == "contradicted"
+    assert _vane_means_check(twin(0.004, SENSOR_CONFIRM_T - 0.5), named)["status"] == "neutral"
+    means = {"estimate": 0.0171, "std_error": 0.0005, "axes": ["CX", "CZ", "Cm"]}
+    assert _vane_means_check(twin(0.0171, 34.2, named.test, {"vane_means": means}), named)["status"] == "confirmed"
+    assert _vane_means_check(twin(0.0171, 34.2, "stepwise on the Cm mismatch"), named)["status"] == "neutral"
+    scaled = twin(0.0085, 8.6)                     # the validation's kinematics also name an α scale:
+    scaled.candidates.append(Candidate("sensor_scale", "lon", "alpha", "scale_alpha", 0.08, 0.009, 9.2, 0.0, "1",
+                                       "kinematic consistency", True))
+    assert _vane_means_check(scaled, named)["status"] == "neutral"   # at trim α a scale reads as a bias

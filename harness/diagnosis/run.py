@@ -328,9 +328,21 @@ def _vane_means_check(av: Analysis, f: Candidate) -> dict:
     """A vane bias named on the coefficient means (:func:`analysis._name_vane_bias_from_means`),
     tested the same way on the validation maneuver: the same vane, so the same sign at
     |t| >= :data:`SENSOR_CONFIRM_T` there ('confirmed'), the opposite sign at that |t|
-    ('contradicted'), else 'neutral'."""
+    ('contradicted'), else 'neutral'. Where the validation maneuver's kinematics gave the bias
+    themselves (its means test is then not run), their estimate is the verdict
+    (:func:`_sensor_check`), unless they also name a scale or skew of that vane: a scale
+    factor reads as a bias at the trim α (8 % of 5.3° is 0.42°), and is then the likelier."""
     twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
     means = (twin.details.get("vane_means") if twin is not None else None) or {}
+    channel = f.parameter.split("_", 1)[1]
+    # a scale (or skew) of the vane named there would explain the same offset at trim α
+    rival = next((c.parameter for c in av.candidates if c.selected and c.parameter in
+                  (f"scale_{channel}", f"skew_{channel}")), None)
+    if not means and twin is not None and twin.test.startswith("kinematic consistency") and rival is None:
+        return _sensor_check(av, f) | {"rule": "the validation maneuver's kinematics gave this vane bias"}
+    if not means and rival is not None:
+        return {"status": "neutral", "axes": [], "estimate": None, "t": None,
+                "reason": f"the validation maneuver's kinematics name {rival}, which at trim reads as this bias"}
     if not means:
         return {"status": "neutral", "axes": [], "estimate": None, "t": None,
                 "reason": "the validation maneuver's coefficient means cannot tell this vane bias"}
