@@ -385,3 +385,18 @@ def test_a_c172x_moment_drift_is_named_once_the_vane_noise_leaves_cm(tmp_path):
     c = next(c for c in cases() if c.name == "C1_three_axis_flight_condition_drift_Cm_dV_0.02")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
+
+
+def test_a_c172x_moment_reference_shift_is_sized_by_the_mistrim_of_cm(tmp_path):
+    """Outside case C2_three_axis (0.25 ft moment-reference shift, c172x at 200 ft/s): the
+    stepwise entered the shift at about 1 ft beside a C_m,α that shared its C_Z column;
+    C_m's constant, the mistrim Δx·mean(C_Z)/c̄ a shift makes, refutes that size and names
+    the one it says (analysis._cg_mean_test): within 2 standard errors or 25 % of 0.25 ft,
+    nothing else named, the validation's q fit better by 30 % or more."""
+    from harness.diagnosis.outside import cases, run_case
+    c = next(c for c in cases() if c.name == "C2_three_axis_cg_offset_dx_moment_reference_0.25")
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["d"] and row["c"] == 0, row["first"]
+    f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
+    assert f["evidence"]["test"] == "the mistrim of C_m (its constant over the mean of C_Z)"
+    assert 0.0 < f["evidence"]["explained_fraction"] <= 1.0

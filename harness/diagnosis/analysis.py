@@ -542,7 +542,7 @@ def _pinned_shift(test: CgMeanTest) -> Candidate:
     t = test.dx_ft / test.std_error_ft if test.std_error_ft > 0 else 0.0
     sel = abs(t) >= cand.T_IN and _practical(test.share)
     return Candidate("cg_offset", cand.AXIS_NAME["Cm"], "Cm", "dx_moment_reference", test.dx_ft, test.std_error_ft,
-                     t, 0.0, "ft", "the mistrim of C_m (its constant over the mean of C_Z)", sel,
+                     t, test.explained, "ft", "the mistrim of C_m (its constant over the mean of C_Z)", sel,
                      "entered" if sel else ("not entered" if abs(t) < cand.T_IN else _impractical_reason(test.share)),
                      {"mistrim_share": test.share})
 
@@ -590,6 +590,7 @@ class CgMeanTest(NamedTuple):
     std_error_ft: float
     pinned: bool      # refuted, yet the mistrim itself is a shift of the same sign (CG_MEAN_Z)
     share: float      # the mistrim over C_m's excursion (its practical size)
+    explained: float  # the share of C_m's mismatch (mean square, its mean included) the shift takes off
 
 
 def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
@@ -609,7 +610,10 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     dx = sel.params["cg"] * term.scale
     inner = _inner(p)
     cbar = p.meta["geometry"]["cbar_ft"]
-    predicted = dx * float(np.mean(measured["CZ"][inner])) / cbar
+    cz = float(np.mean(measured["CZ"][inner]))
+    if cz == 0.0:
+        return None  # no lift on average (a zero-g arc): the mean says nothing of a shift
+    predicted = dx * cz / cbar
     cm_sel, cm_terms = selections["Cm"]
     cols = [cm_terms[k].column[inner] for k in cm_sel.names if k in cm_terms and k != "cg"]
     cols += [c[inner] for c in nuisances.get("Cm", {}).values() if np.ptp(c[inner]) > 0]
@@ -618,17 +622,19 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     # only a mistrim short of the prediction refutes: one beyond it (a larger shift, which the
     # other entered terms shared out) supports the shift
     short = abs(predicted) - mean * np.sign(predicted)
-    cz = float(np.mean(measured["CZ"][inner]))
     dx_mean, se_mean = mean * cbar / cz, mean_se * cbar / abs(cz)
     share = abs(mean) / max(float(np.std(measured["Cm"][inner])), 1e-300)
+    z = mismatch["Cm"][inner]
+    explained = 1.0 - float(np.mean((z - dx_mean / cbar * measured["CZ"][inner]) ** 2)) / max(float(np.mean(z ** 2)),
+                                                                                           1e-300)
     if short <= CG_MEAN_SHARE * abs(predicted) or short <= CG_MEAN_Z * mean_se:
-        return CgMeanTest(False, "", dx_mean, se_mean, False, share)
+        return CgMeanTest(False, "", dx_mean, se_mean, False, share, explained)
     pinned = mean * np.sign(predicted) >= CG_MEAN_Z * mean_se
     reason = (f"refuted by the mean of C_m: the shift of {dx:.3g} ft the {axis} mismatch suggests would mistrim "
               f"C_m by {predicted:+.2g}; C_m's mismatch has a constant of {mean:+.2g} ± {mean_se:.1g}")
     if pinned:
         reason += f", the mistrim of a {dx_mean:.3g} ± {se_mean:.2g} ft shift, named instead"
-    return CgMeanTest(True, reason, dx_mean, se_mean, bool(pinned), share)
+    return CgMeanTest(True, reason, dx_mean, se_mean, bool(pinned), share, explained)
 
 
 def _slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],

@@ -338,14 +338,12 @@ def _vane_means_check(av: Analysis, f: Candidate) -> dict:
     # a scale (or skew) of the vane named there would explain the same offset at trim α
     rival = next((c.parameter for c in av.candidates if c.selected and c.parameter in
                   (f"scale_{channel}", f"skew_{channel}")), None)
-    if not means and twin is not None and twin.test.startswith("kinematic consistency") and rival is None:
-        return _sensor_check(av, f) | {"rule": "the validation maneuver's kinematics gave this vane bias"}
-    if not means and rival is not None:
-        return {"status": "neutral", "axes": [], "estimate": None, "t": None,
-                "reason": f"the validation maneuver's kinematics name {rival}, which at trim reads as this bias"}
     if not means:
-        return {"status": "neutral", "axes": [], "estimate": None, "t": None,
-                "reason": "the validation maneuver's coefficient means cannot tell this vane bias"}
+        if rival is None and twin is not None and twin.test.startswith("kinematic consistency"):
+            return _sensor_check(av, f) | {"rule": "the validation maneuver's kinematics gave this vane bias"}
+        why = (f"the validation maneuver's kinematics name {rival}, which at trim reads as this bias" if rival else
+               "the validation maneuver's coefficient means cannot tell this vane bias")
+        return {"status": "neutral", "axes": [], "estimate": None, "t": None, "reason": why}
     v, sv = means["estimate"], means["std_error"]
     t = v / sv if sv > 0 else 0.0
     return {"status": _same_instrument_status(v, t, f.estimate), "axes": list(means["axes"]), "estimate": float(v),
