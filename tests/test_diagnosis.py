@@ -301,3 +301,37 @@ def test_gallery_structural_mode_is_modelled_as_a_notch(gallery):
     assert after["az"]["rms_raw"] < before["az"]["rms_raw"]
     sensors = gallery["structural_mode"]["model"]["terms"]  # aircraft terms: none for a mode
     assert not [t for t in sensors if t.get("effect") == "structural_mode"]
+
+
+def test_local_maxima_of_a_spectrum():
+    from harness.diagnosis.spectra import local_maxima
+    P = np.array([5.0, 4.0, 3.0, 6.0, 6.0, 2.0, 1.0, 1.5])
+    assert local_maxima(P).tolist() == [False, False, False, True, False, False, False, False]
+
+
+def test_the_maneuvers_own_shoulder_through_the_band_edge_is_no_mode(monkeypatch):
+    """Motion up to ~2 Hz that the common filter (cut-off 0.7 Hz) leaves in the residual, as
+    a sharp aileron input on a light aircraft does, falls through the peak test's lower edge
+    (2 Hz): its ordinates there stand far above the running median, which the quiet band
+    below the cut-off pulls down, but the spectrum falls; only a local maximum is a mode. A
+    real 8 Hz mode on the same record still is one."""
+    from types import SimpleNamespace
+
+    from scipy import signal as sg
+
+    from harness.diagnosis import spectra
+    fs, n = 50.0, 1500
+    rng = np.random.default_rng(3)
+    b, a = sg.butter(4, [0.7 / (fs / 2), 2.3 / (fs / 2)], btype="band")
+    q = 0.002 * rng.normal(size=n) + sg.filtfilt(b, a, 0.05 * rng.normal(size=n))
+
+    def record(x):
+        return SimpleNamespace(dt=1.0 / fs, n=n, raw={"q": x}, smooth={"q": np.zeros(n)}, common_cutoff_hz=0.7)
+
+    p = record(q)
+    assert spectra.structural_peak(p) is None or spectra.structural_peak(p).p_value > spectra.FISHER_P
+    mode = spectra.structural_peak(record(q + 0.003 * np.sin(2 * np.pi * 8.0 * np.arange(n) / fs)))
+    assert mode.p_value < spectra.FISHER_P and abs(mode.frequency_hz - 8.0) < 0.25
+    monkeypatch.setattr(spectra, "local_maxima", lambda P: np.ones(P.size, dtype=bool))
+    edge = spectra.structural_peak(p)  # without the rule, the shoulder is a 'mode' at the edge
+    assert edge.p_value < spectra.FISHER_P and edge.frequency_hz < 2.6

@@ -533,3 +533,30 @@ def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematic
     scaled.candidates.append(Candidate("sensor_scale", "lon", "alpha", "scale_alpha", 0.08, 0.009, 9.2, 0.0, "1",
                                        "kinematic consistency", True))
     assert _vane_means_check(scaled, named)["status"] == "neutral"   # at trim α a scale reads as a bias
+
+
+def test_a_control_delay_the_kinematics_show_as_a_gyro_skew_is_withheld():
+    """analysis._withhold_skewed_delay: the kinematics' q skew (0.057 ± 0.015 s, t 3.8) and a
+    stabilator delay fitted at 0.042 ± 0.0016 s differ by 1.0 standard error of their
+    difference (both errors combined), so the delay is withheld; a skew of the other sign, or
+    one 0.2 s away, leaves it. (An F-16 multisine at 12,000 ft with a 40 ms q skew named
+    the delay before the skew's own error was counted.)"""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import Candidate, _withhold_skewed_delay
+
+    def kin(skew, t):
+        return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[SimpleNamespace(name="skew_q",
+                                                                                           estimate=skew, t=t)]))
+
+    def delay():
+        return Candidate("control_delay", "pitch", "de", "tau_de", 0.042, 0.0016, 25.0, 0.9, "s",
+                         "delay scan of de + stepwise", selected=True, reason="entered")
+
+    same, opposite, far = delay(), delay(), delay()
+    _withhold_skewed_delay(same, kin(0.057, 3.8))
+    _withhold_skewed_delay(opposite, kin(-0.057, 3.8))
+    _withhold_skewed_delay(far, kin(0.25, 3.8))
+    assert not same.selected and same.details["sensor_rival"] == "skew_q"
+    assert "lagging by 0.057 s (skew_q, t = 3.8)" in same.reason
+    assert opposite.selected and far.selected

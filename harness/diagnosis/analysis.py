@@ -850,14 +850,17 @@ def _kin_estimate(kin: KinematicResult, name: str) -> tuple[float, float] | None
 
 def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
     """Deselect a control delay the kinematics can explain as a time skew of the rate its
-    surface drives (same sign, |t| >= :data:`AMBIGUOUS_T`, size within 2 standard errors or
-    30 %): a gyro that lags imitates an actuator that lags."""
+    surface drives (same sign, |t| >= :data:`AMBIGUOUS_T`, the two sizes within 2 standard
+    errors of their difference, both estimates' errors combined, or 30 %): a gyro that lags
+    imitates an actuator that lags."""
     name = f"skew_{SURFACE_RATE.get(c.channel, '')}"
     found = _kin_estimate(kin, name)
     if found is None:
         return
     skew, t = found
-    close = abs(skew - c.estimate) <= max(2.0 * c.std_error, 0.3 * abs(c.estimate))
+    # the two estimates' difference against its own standard error (both are uncertain)
+    se_diff = float(np.hypot(c.std_error, abs(skew) / max(t, 1e-12)))
+    close = abs(skew - c.estimate) <= max(2.0 * se_diff, 0.3 * abs(c.estimate))
     if t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and close:
         c.selected = False
         c.details["sensor_rival"] = name

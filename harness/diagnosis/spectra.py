@@ -52,7 +52,8 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
     lightly damped mode, rung by each input and decaying within a second or two, a peak a
     few bins wide rather than a scatter of single-ordinate spikes. Each ordinate is compared
     with the running median within ``half_width_hz``, so coloured (sloping) noise is not a
-    peak. The frequency is the power-weighted centroid of the peak bin and its neighbours."""
+    peak, and only a local maximum of the spectrum (:func:`local_maxima`) is a candidate. The
+    frequency is the power-weighted centroid of the peak bin and its neighbours."""
     best = None
     fs = 1.0 / p.dt
     nper = int(round(segment_s * fs))
@@ -72,7 +73,9 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
         if band.sum() < 2 * w:
             continue
         ratio = np.where(med > 0, P / np.maximum(med, 1e-300), 0.0)
-        idx = np.flatnonzero(band)
+        idx = np.flatnonzero(band & local_maxima(P))
+        if idx.size == 0:
+            continue
         k = int(idx[np.argmax(ratio[idx])])
         pv = peak_p_value(float(ratio[k]), int(band.sum()), dof)
         if best is None or pv < best.p_value:
@@ -81,6 +84,16 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
             fc, se = _refine(x, fs, float(f[k]), df, nper)
             best = PeakTest(c, fc, se, float(np.sqrt(np.sum(excess) * df)), float(ratio[k]), pv)
     return best
+
+
+def local_maxima(P: np.ndarray) -> np.ndarray:
+    """Where the spectrum ``P`` stands above the ordinate below it and at least as high as
+    the one above: a mode's peak. The shoulder of the maneuver's own spectrum, falling
+    through the band's lower edge, is not one however far it stands above the running
+    median (which the quiet ordinates below the common filter's cut-off pull down)."""
+    out = np.zeros(P.size, dtype=bool)
+    out[1:-1] = (P[1:-1] > P[:-2]) & (P[1:-1] >= P[2:])
+    return out
 
 
 def _refine(x: np.ndarray, fs: float, f_peak: float, df: float, nper: int) -> tuple[float, float]:
