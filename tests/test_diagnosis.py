@@ -335,3 +335,24 @@ def test_the_maneuvers_own_shoulder_through_the_band_edge_is_no_mode(monkeypatch
     monkeypatch.setattr(spectra, "local_maxima", lambda P: np.ones(P.size, dtype=bool))
     edge = spectra.structural_peak(p)  # without the rule, the shoulder is a 'mode' at the edge
     assert edge.p_value < spectra.FISHER_P and edge.frequency_hz < 2.6
+
+
+def test_kinematic_alpha_rate_is_exact_for_rigid_body_motion():
+    """kinematics.kinematic_alpha_rate against the analytic α̇ of a made-up motion: V, α, β,
+    the rates and attitude chosen freely, the accelerometers given what the u and w
+    equations make them (specific force in g)."""
+    from harness.diagnosis.kinematics import kinematic_alpha_rate
+    from models.constants import G0_FPS2 as G0
+    t = np.linspace(0.0, 10.0, 501)
+    V, Vd = 500.0 + 20.0 * np.sin(0.3 * t), 6.0 * np.cos(0.3 * t)
+    a, ad = 0.08 + 0.05 * np.sin(1.7 * t), 0.085 * np.cos(1.7 * t)
+    b, bd = 0.03 * np.sin(0.9 * t), 0.027 * np.cos(0.9 * t)
+    P, Q, R = 0.2 * np.sin(0.5 * t), 0.1 * np.cos(1.1 * t), 0.05 * np.sin(0.7 * t)
+    phi, th = 0.3 * np.sin(0.2 * t), 0.1 + 0.05 * np.cos(0.4 * t)
+    u, v, w = V * np.cos(a) * np.cos(b), V * np.sin(b), V * np.sin(a) * np.cos(b)
+    ud = Vd * np.cos(a) * np.cos(b) - V * np.sin(a) * ad * np.cos(b) - V * np.cos(a) * np.sin(b) * bd
+    wd = Vd * np.sin(a) * np.cos(b) + V * np.cos(a) * ad * np.cos(b) - V * np.sin(a) * np.sin(b) * bd
+    ax = (ud - R * v + Q * w + G0 * np.sin(th)) / G0
+    az = (wd - Q * u + P * v - G0 * np.cos(th) * np.cos(phi)) / G0
+    ch = {"V": V, "alpha": a, "beta": b, "p": P, "q": Q, "r": R, "phi": phi, "theta": th, "ax": ax, "az": az}
+    np.testing.assert_allclose(kinematic_alpha_rate(ch), ad, atol=1e-12)

@@ -379,7 +379,7 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
     (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
     sideslip with ``vane_beta``; both vanes' own records with ``vanes``)."""
     states, surfaces = model_states(p, inertial_from, vane_beta, vanes)
-    alphadot = p.deriv["alpha"] if "alpha" in p.driven or "alpha" in p.moved else None
+    alphadot = cand.alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
     return ModelAlong(states, surfaces, alphadot, aero, measured)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
+from harness.diagnosis.kinematics import kinematic_alpha_rate
 from harness.diagnosis.prepare import Prepared, filtered_noise_std
 from models.constants import SURFACES
 
@@ -57,6 +58,23 @@ def regressors(p: Prepared) -> dict[str, np.ndarray]:
     return out
 
 
+# The channels the kinematic α̇ is built on (kinematics.kinematic_alpha_rate).
+ALPHA_RATE_CHANNELS = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ax", "az")
+# The axes measured with the accelerometers that α̇ is built on: their α̇ column is the α
+# record's derivative instead, whose noise is not the measurement's own.
+VANE_ALPHA_RATE_AXES = ("CX", "CZ")
+
+
+def alpha_rate(p: Prepared, axis: str = "Cm") -> np.ndarray:
+    """α̇ (rad/s) along the recording, for a term of ``axis`` or the model's α̇ terms: the
+    kinematic one (:func:`kinematics.kinematic_alpha_rate`, from the gyros, accelerometers
+    and attitude through the common filter), whose noise is a fraction of the differentiated
+    vane's; on the force axes (:data:`VANE_ALPHA_RATE_AXES`) the α record's derivative."""
+    if axis in VANE_ALPHA_RATE_AXES or not all(c in p.smooth for c in ALPHA_RATE_CHANNELS):
+        return p.deriv["alpha"]
+    return kinematic_alpha_rate(p.smooth)
+
+
 def effective_derivatives(p: Prepared, axis: str, model: np.ndarray) -> dict[str, float]:
     """The model's own derivatives of ``axis`` over this maneuver: its coefficient along the
     recorded states regressed on the axis's own regressors (and a constant). Equal to the
@@ -97,7 +115,7 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
                                        "trim_value": derivatives.get(f"{axis}_{r}", float("nan"))},
                               sources=(REGRESSOR_SOURCE[r],)))
     if axis in LON:
-        adot = p.deriv["alpha"] * geo["cbar_ft"] / (2.0 * p.smooth["V"])
+        adot = alpha_rate(p, axis) * geo["cbar_ft"] / (2.0 * p.smooth["V"])
         terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)", adot,
                           sources=("alpha",)))
         terms.append(Term("alpha2", "nonlinear_alpha", f"{axis}_alpha2", "per rad^2", a ** 2, sources=("alpha",)))

@@ -182,6 +182,27 @@ def inertial_angles(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndar
     return {"alpha": np.arctan2(w_i, u), "beta": beta}
 
 
+def kinematic_alpha_rate(ch: dict[str, np.ndarray]) -> np.ndarray:
+    """α̇ from the u and w equations of the module docstring, α = atan(w/u):
+
+        α̇ = (u ẇ − w u̇) / (u² + w²)
+           = q − tanβ (p cosα + r sinα)
+             + g / (V cosβ) · (a_z cosα − a_x sinα + cosθ cosφ cosα + sinθ sinα)
+
+    (inertial: in gusts the air-relative α̇ differs by the gust's own rate). Built from the
+    gyros and accelerometers, it carries their noise instead of the vane's: differentiating
+    the α record amplifies the vane noise within the common filter's band, by 20-100 % of
+    the signal on the outside sweep's pitch maneuvers (a low-amplitude frequency sweep at
+    500 ft/s: more noise than signal) against 5-20 % this way. A term fitted on the noisy
+    derivative is attenuated (errors in variables), and a model evaluated along it passes
+    the noise on through its own α̇ derivatives."""
+    V, a, b = ch["V"], ch["alpha"], ch["beta"]
+    P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
+    gravity = np.cos(th) * np.cos(phi) * np.cos(a) + np.sin(th) * np.sin(a)
+    return (Q - np.tan(b) * (P * np.cos(a) + R * np.sin(a))
+            + G0 / (V * np.cos(b)) * (ch["az"] * np.cos(a) - ch["ax"] * np.sin(a) + gravity))
+
+
 def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndarray]:
     """E per kinematic equation (module docstring) from raw-rate channels ``ch``."""
     V, a, b = ch["V"], ch["alpha"], ch["beta"]
