@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from harness.diagnosis.run import DiagnosisError, diagnose
@@ -535,28 +536,66 @@ def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematic
     assert _vane_means_check(scaled, named)["status"] == "neutral"   # at trim α a scale reads as a bias
 
 
-def test_a_control_delay_the_kinematics_show_as_a_gyro_skew_is_withheld():
-    """analysis._withhold_skewed_delay: the kinematics' q skew (0.057 ± 0.015 s, t 3.8) and a
-    stabilator delay fitted at 0.042 ± 0.0016 s differ by 1.0 standard error of their
-    difference (both errors combined), so the delay is withheld; a skew of the other sign, or
-    one 0.2 s away, leaves it. (An F-16 multisine at 12,000 ft with a 40 ms q skew named
-    the delay before the skew's own error was counted.)"""
+def test_a_control_delay_the_kinematics_cannot_tell_from_a_gyro_skew_is_withheld():
+    """analysis._withhold_skewed_delay: a delay is named only when the kinematics rule out a
+    lag of the rate its surface drives of the same size. The kinematics' q skew of
+    0.057 ± 0.015 s (t 3.8, an F-16 multisine with a 40 ms q skew) and a weak 0.055 ± 0.026 s
+    (t 2.1, a 737 aileron sweep with a 40 ms p skew) both lie within two standard errors of
+    a 0.042 ± 0.0016 s delay: withheld. A skew of 0.002 ± 0.003 s (a true delay's kinematics)
+    or one of the other sign rule it out; a skew not tested leaves the delay named, with the
+    caveat."""
     from types import SimpleNamespace
 
     from harness.diagnosis.analysis import Candidate, _withhold_skewed_delay
 
-    def kin(skew, t):
-        return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[SimpleNamespace(name="skew_q",
-                                                                                           estimate=skew, t=t)]))
+    def kin(skew, se):
+        return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[SimpleNamespace(
+            name="skew_q", estimate=skew, std_error=se, t=skew / se)]))
 
     def delay():
         return Candidate("control_delay", "pitch", "de", "tau_de", 0.042, 0.0016, 25.0, 0.9, "s",
                          "delay scan of de + stepwise", selected=True, reason="entered")
 
-    same, opposite, far = delay(), delay(), delay()
-    _withhold_skewed_delay(same, kin(0.057, 3.8))
-    _withhold_skewed_delay(opposite, kin(-0.057, 3.8))
-    _withhold_skewed_delay(far, kin(0.25, 3.8))
-    assert not same.selected and same.details["sensor_rival"] == "skew_q"
-    assert "lagging by 0.057 s (skew_q, t = 3.8)" in same.reason
-    assert opposite.selected and far.selected
+    shown, weak, ruled_out, opposite, untested = delay(), delay(), delay(), delay(), delay()
+    _withhold_skewed_delay(shown, kin(0.057, 0.015))
+    _withhold_skewed_delay(weak, kin(0.055, 0.026))
+    _withhold_skewed_delay(ruled_out, kin(0.002, 0.003))
+    _withhold_skewed_delay(opposite, kin(-0.057, 0.015))
+    _withhold_skewed_delay(untested, SimpleNamespace(selection=SimpleNamespace(params={}, terms=[])))
+    assert not shown.selected and shown.details["sensor_rival"] == "skew_q"
+    assert "lagging by 0.057 ± 0.015 s (skew_q, t = 3.8), which looks like this delay" in shown.reason
+    assert not weak.selected and "does not rule out a lag of this size" in weak.reason
+    assert ruled_out.selected and opposite.selected
+    assert untested.selected and "q-gyro lag" in untested.details["not_ruled_out"]
+
+
+def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
+    """analysis._scale_read_as_bias: an α reading (1 + k)·α stands k·ᾱ off at the mean α,
+    which the kinematic fit gives as a bias. With ᾱ 0.12 rad (0.011 of it the bias) a bias
+    of 0.011 ± 0.0008 rad says k = 0.100 ± 0.007, and the scale tried beside it says
+    0.086 ± 0.022 (t 3.9): one scale, named at their inverse-variance mean, the bias read as
+    its offset. A scale of the other sign, one far from it, or one the kinematics do not
+    suspect (t under 2.5) leaves the bias named."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import Candidate, _scale_read_as_bias
+    p = SimpleNamespace(smooth={"alpha": np.full(100, 0.121), "V": np.full(100, 450.0)}, dt=0.02)
+
+    def pair(k, se_k):
+        bias = Candidate("sensor_bias", None, "alpha", "bias_alpha", 0.011, 0.0008, 13.8, 0.0, "rad",
+                         "kinematic consistency (bias always fitted)", True, "significant, practical and precise")
+        scale = Candidate("sensor_scale", None, "alpha", "scale_alpha", k, se_k, k / se_k, 0.01, "1",
+                          "kinematic consistency", False, "below the entry t")
+        return bias, scale
+
+    bias, scale = pair(0.086, 0.022)
+    _scale_read_as_bias([bias, scale], None, p)
+    w = np.array([1 / (0.0008 / 0.11) ** 2, 1 / 0.022 ** 2])
+    expected = float(np.dot(w, [0.1, 0.086]) / w.sum())
+    assert scale.selected and not bias.selected and bias.details["read_as"] == "scale_alpha"
+    assert scale.estimate == pytest.approx(expected) and scale.std_error == pytest.approx(1 / np.sqrt(w.sum()))
+    assert scale.details["corroboration"] == {"named": True, "kinematic": 0.086, "kinematic_std": 0.022}
+    for k, se in ((-0.086, 0.022), (0.30, 0.03), (0.05, 0.022)):
+        bias, scale = pair(k, se)
+        _scale_read_as_bias([bias, scale], None, p)
+        assert bias.selected and not scale.selected

@@ -107,6 +107,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     air = _air_share(p, aircraft, ic, along, slope_of, gust, V0) if turbulent or gusty or near else None
     turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
     cands = _kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
+    _scale_read_as_bias(cands, kin, recorded)
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
     as_evaluated = dict(mismatch)
@@ -286,6 +287,53 @@ def _sensor_verdict(name: str, est: float, se: float, entered: bool, kin: Kinema
               "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else
               f"not applied: {gusty}" if gusty else IMPLAUSIBLE)
     return sel, reason
+
+
+# The channels whose trim value is far from zero, where a scale factor shows as an offset:
+# the α vane (k·α at the trim α) and the airspeed (k·V).
+OFFSET_SCALE_CHANNELS = ("alpha", "V")
+
+
+def _scale_read_as_bias(cands: list[Candidate], kin: KinematicResult, p: Prepared) -> None:
+    """Rename a named bias of α or V that is a scale factor's offset. A reading (1 + k)·x
+    stands k·x̄ off at the maneuver's mean x̄, which the kinematic fit (a bias always in it)
+    gives as a bias b, and moves k times the excursions, which it gives as the scale k when
+    tried beside the bias. When that k is itself suspect (|t| >= :data:`AMBIGUOUS_T`) and the
+    two say the same scale — k and b/x̄_true within two standard errors of their difference
+    — the finding is the scale, sized as their inverse-variance mean, and the bias is read
+    as its offset. A true bias leaves k near zero. (An F-16 at 20,000 ft and 450 ft/s with
+    a 10 % α-vane scale was named a 0.63° α bias, b/x̄ = 0.100 ± 0.008 against
+    k = 0.086 ± 0.022.) The validation maneuver judges it as a finding named on two tests
+    (``details['corroboration']``: its kinematic k, same sign, |t| >= 2, within two standard
+    errors)."""
+    for channel in OFFSET_SCALE_CHANNELS:
+        bias = next((c for c in cands if c.selected and c.parameter == f"bias_{channel}"), None)
+        scale = next((c for c in cands if c.parameter == f"scale_{channel}"), None)
+        if bias is None or scale is None or abs(scale.t) < AMBIGUOUS_T or channel not in p.smooth:
+            continue
+        x_true = float(np.mean(p.smooth[channel])) - bias.estimate
+        if abs(x_true) <= 0.0:
+            continue
+        k_off, se_off = bias.estimate / x_true, bias.std_error / abs(x_true)
+        if np.sign(k_off) != np.sign(scale.estimate) or \
+                abs(k_off - scale.estimate) > 2.0 * np.hypot(se_off, scale.std_error):
+            continue
+        k_exc, se_exc = scale.estimate, scale.std_error
+        w = np.array([1.0 / se_off ** 2, 1.0 / se_exc ** 2])
+        k = float(np.dot(w, [k_off, k_exc]) / w.sum())
+        se = float(1.0 / np.sqrt(w.sum()))
+        V_mean = float(np.mean(p.smooth["V"]))
+        if not (is_plausible(scale.parameter, k, V_mean) and is_practical(scale.parameter, k, p.dt)):
+            continue
+        scale.estimate, scale.std_error, scale.t, scale.selected = k, se, k / se, True
+        scale.reason = (f"the offset at the mean {channel} (a bias of {bias.estimate:.4g}: k = {k_off:.3f} ± "
+                        f"{se_off:.3f}) and the excursions (k = {k_exc:.3f} ± {se_exc:.3f}) agree on a scale factor")
+        scale.details.update({"offset": {"bias": bias.estimate, "bias_std": bias.std_error, "mean_true": x_true,
+                                         "k": k_off, "k_std": se_off, "excursion_k": k_exc, "excursion_k_std": se_exc},
+                              "corroboration": {"named": True, "kinematic": k_exc, "kinematic_std": se_exc}})
+        bias.selected = False
+        bias.details["read_as"] = scale.parameter
+        bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
 
 
 def _kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool,
@@ -848,24 +896,41 @@ def _kin_estimate(kin: KinematicResult, name: str) -> tuple[float, float] | None
     return None if term is None else (term.estimate, abs(term.t))
 
 
+def _kin_std_error(kin: KinematicResult, name: str) -> float:
+    """The standard error of a kinematic parameter :func:`_kin_estimate` found."""
+    if name in kin.selection.params:
+        return float(kin.selection.std_errors.get(name, np.inf))
+    term = next(t for t in kin.selection.terms if t.name == name)
+    return float(term.std_error)
+
+
 def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
-    """Deselect a control delay the kinematics can explain as a time skew of the rate its
-    surface drives (same sign, |t| >= :data:`AMBIGUOUS_T`, the two sizes within 2 standard
-    errors of their difference, both estimates' errors combined, or 30 %): a gyro that lags
-    imitates an actuator that lags."""
-    name = f"skew_{SURFACE_RATE.get(c.channel, '')}"
+    """Deselect a control delay the kinematics cannot tell from a time skew of the rate its
+    surface drives: a gyro that lags imitates an actuator that lags (the coefficient measured
+    from the lagging rate's derivative, less the model along the lagging rate, leaves the
+    surface's term late by the same time). Withheld when the kinematic skew lies within two
+    standard errors of the delay (both estimates' errors combined: they do not rule a skew of
+    that size out), or shows (|t| >= :data:`AMBIGUOUS_T`, same sign) within 30 % of it. A
+    skew the kinematics could not test (the rate hardly moves) leaves the delay named, with
+    the caveat in ``details['not_ruled_out']``."""
+    rate = SURFACE_RATE.get(c.channel, "")
+    name = f"skew_{rate}"
     found = _kin_estimate(kin, name)
     if found is None:
+        c.details["not_ruled_out"] = (f"a {rate}-gyro lag of the same size would look alike; the kinematic check did "
+                                      f"not test one ({name} not offered)")
         return
     skew, t = found
-    # the two estimates' difference against its own standard error (both are uncertain)
-    se_diff = float(np.hypot(c.std_error, abs(skew) / max(t, 1e-12)))
-    close = abs(skew - c.estimate) <= max(2.0 * se_diff, 0.3 * abs(c.estimate))
-    if t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and close:
+    se_skew = _kin_std_error(kin, name)
+    se_diff = float(np.hypot(c.std_error, se_skew))
+    gap = abs(skew - c.estimate)
+    shows = t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and gap <= 0.3 * abs(c.estimate)
+    if gap <= 2.0 * se_diff or shows:
         c.selected = False
         c.details["sensor_rival"] = name
-        c.reason = (f"entered, but not named: the kinematics show the {SURFACE_RATE[c.channel]} channel lagging by "
-                    f"{skew:.3f} s ({name}, t = {t:.1f}), which looks like this delay")
+        c.reason = (f"entered, but not named: the kinematics show the {rate} channel lagging by {skew:.3f} ± "
+                    f"{se_skew:.3f} s ({name}, t = {t:.1f}), which "
+                    + ("looks like this delay" if t >= AMBIGUOUS_T else "does not rule out a lag of this size"))
 
 
 # A suspected sensor error withholds a term only if, anywhere within IMITATION_Z standard

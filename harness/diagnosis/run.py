@@ -136,7 +136,8 @@ def _terms_of(findings: list[Candidate], applied: dict[str, float]) -> tuple[Hid
             continue
         out.append(e)
         bias = f"bias_{e.channel}"
-        if e.effect == "sensor_scale" and bias in applied and not any(g.parameter == bias for g in findings):
+        if e.effect == "sensor_scale" and bias in applied and not any(g.parameter == bias for g in findings) \
+                and "offset" not in f.details:  # a scale read from the bias carries it (analysis._scale_read_as_bias)
             out.append(HiddenEffect("sensor_bias", float(applied[bias]), channel=e.channel))
     return tuple(out)
 
