@@ -589,7 +589,7 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
         return bias, scale
 
     bias, scale = pair(0.086, 0.022)
-    _scale_read_as_bias([bias, scale], None, p)
+    _scale_read_as_bias([bias, scale], p)
     w = np.array([1 / (0.0008 / 0.11) ** 2, 1 / 0.022 ** 2])
     expected = float(np.dot(w, [0.1, 0.086]) / w.sum())
     assert scale.selected and not bias.selected and bias.details["read_as"] == "scale_alpha"
@@ -597,5 +597,5 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     assert scale.details["corroboration"] == {"named": True, "kinematic": 0.086, "kinematic_std": 0.022}
     for k, se in ((-0.086, 0.022), (0.30, 0.03), (0.05, 0.022)):
         bias, scale = pair(k, se)
-        _scale_read_as_bias([bias, scale], None, p)
+        _scale_read_as_bias([bias, scale], p)
         assert bias.selected and not scale.selected

@@ -400,3 +400,24 @@ def test_a_c172x_moment_reference_shift_is_sized_by_the_mistrim_of_cm(tmp_path):
     f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
     assert f["evidence"]["test"] == "the mistrim of C_m (its constant over the mean of C_Z)"
     assert 0.0 < f["evidence"]["explained_fraction"] <= 1.0
+
+
+def test_an_alpha_scale_at_the_flap_switch_is_named_alone(tmp_path):
+    """A 10 % α-vane scale on a pitch maneuver at 427.4 ft/s and 10,000 ft (the issue's
+    condition; seed 2106, not a sweep case): the coefficient means name the scale's offset
+    at trim α (0.47° at 5.03°) as a bias and the force mismatch along the scaled α asks for
+    an accelerometer 6.9 ft forward. The bias is read as the scale's offset
+    (analysis._scale_read_as_bias) and the position, fitted again along the corrected α,
+    vanishes (analysis._withhold_offset_of_a_scaled_vane): the scale alone, its size within
+    2 standard errors or 25 %."""
+    from dataclasses import replace
+
+    from harness.diagnosis.outside import H, OutsideCase, _drops, run_case
+    c = replace(OutsideCase("F_pitch_sensor_scale_scale_alpha_s2106", "F", "pitch",
+                            (H("sensor_scale", 0.1, channel="alpha"),), "sensor_scale", "scale_alpha", 0.1, "alpha",
+                            seed=2106), drop=_drops(2106))
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, (row["first"], row["false"])
+    f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
+    bias = next(x for x in f["candidates"] if x["parameter"] == "bias_alpha")
+    assert bias["reason"].startswith("read as the offset of scale_alpha")

@@ -107,7 +107,6 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     air = _air_share(p, aircraft, ic, along, slope_of, gust, V0) if turbulent or gusty or near else None
     turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
     cands = _kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
-    _scale_read_as_bias(cands, kin, recorded)
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
     as_evaluated = dict(mismatch)
@@ -142,6 +141,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                                            sensor_values.get(f"bias_{vane}", 0.0))
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             _name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
+            _scale_read_as_bias(cands, recorded)
+            _withhold_offset_of_a_scaled_vane(cands, kin, p, aircraft, ic, as_evaluated, noise, sensor_values)
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += _spectral_candidates(peak, gust, turbulent, light, air)
@@ -294,16 +295,18 @@ def _sensor_verdict(name: str, est: float, se: float, entered: bool, kin: Kinema
 OFFSET_SCALE_CHANNELS = ("alpha", "V")
 
 
-def _scale_read_as_bias(cands: list[Candidate], kin: KinematicResult, p: Prepared) -> None:
+def _scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
     """Rename a named bias of α or V that is a scale factor's offset. A reading (1 + k)·x
     stands k·x̄ off at the maneuver's mean x̄, which the kinematic fit (a bias always in it)
-    gives as a bias b, and moves k times the excursions, which it gives as the scale k when
-    tried beside the bias. When that k is itself suspect (|t| >= :data:`AMBIGUOUS_T`) and the
-    two say the same scale — k and b/x̄_true within two standard errors of their difference
-    — the finding is the scale, sized as their inverse-variance mean, and the bias is read
-    as its offset. A true bias leaves k near zero. (An F-16 at 20,000 ft and 450 ft/s with
-    a 10 % α-vane scale was named a 0.63° α bias, b/x̄ = 0.100 ± 0.008 against
-    k = 0.086 ± 0.022.) The validation maneuver judges it as a finding named on two tests
+    or the coefficient means along the vane give as a bias b, and moves k times the
+    excursions, which the kinematic fit gives as the scale k. When that k is named or
+    suspect (|t| >= :data:`AMBIGUOUS_T`) and the two say the same scale — k and b/x̄_true
+    within two standard errors of their difference — the finding is the scale, sized as
+    their inverse-variance mean, and the bias is read as its offset. A true bias leaves k
+    near zero. (An F-16 at 20,000 ft and 450 ft/s with a 10 % α-vane scale was named a 0.63°
+    α bias, b/x̄ = 0.100 ± 0.008 against k = 0.086 ± 0.022; at 427.4 ft/s the means named a
+    0.47° bias ahead of the scale the kinematics had named.) A scale the kinematics had not
+    named is judged on the validation maneuver as a finding named on two tests
     (``details['corroboration']``: its kinematic k, same sign, |t| >= 2, within two standard
     errors)."""
     for channel in OFFSET_SCALE_CHANNELS:
@@ -318,7 +321,7 @@ def _scale_read_as_bias(cands: list[Candidate], kin: KinematicResult, p: Prepare
         if np.sign(k_off) != np.sign(scale.estimate) or \
                 abs(k_off - scale.estimate) > 2.0 * np.hypot(se_off, scale.std_error):
             continue
-        k_exc, se_exc = scale.estimate, scale.std_error
+        k_exc, se_exc, named = scale.estimate, scale.std_error, scale.selected
         w = np.array([1.0 / se_off ** 2, 1.0 / se_exc ** 2])
         k = float(np.dot(w, [k_off, k_exc]) / w.sum())
         se = float(1.0 / np.sqrt(w.sum()))
@@ -328,12 +331,39 @@ def _scale_read_as_bias(cands: list[Candidate], kin: KinematicResult, p: Prepare
         scale.estimate, scale.std_error, scale.t, scale.selected = k, se, k / se, True
         scale.reason = (f"the offset at the mean {channel} (a bias of {bias.estimate:.4g}: k = {k_off:.3f} ± "
                         f"{se_off:.3f}) and the excursions (k = {k_exc:.3f} ± {se_exc:.3f}) agree on a scale factor")
-        scale.details.update({"offset": {"bias": bias.estimate, "bias_std": bias.std_error, "mean_true": x_true,
-                                         "k": k_off, "k_std": se_off, "excursion_k": k_exc, "excursion_k_std": se_exc},
-                              "corroboration": {"named": True, "kinematic": k_exc, "kinematic_std": se_exc}})
+        scale.details["offset"] = {"bias": bias.estimate, "bias_std": bias.std_error, "mean_true": x_true,
+                                   "k": k_off, "k_std": se_off, "excursion_k": k_exc, "excursion_k_std": se_exc}
+        if not named:  # the kinematics alone had not named it: judged as named on two tests
+            scale.details["corroboration"] = {"named": True, "kinematic": k_exc, "kinematic_std": se_exc}
         bias.selected = False
         bias.details["read_as"] = scale.parameter
         bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
+
+
+def _withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResult, p: Prepared,
+                                      aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
+                                      noise: dict[str, float], applied: dict[str, float]) -> None:
+    """Withhold an accelerometer position fitted to the force mismatches when an α-vane
+    scale is named that was not applied to the channels the model was evaluated along: the
+    model along the scaled α is off by C_Z,α·k·α, which in a short-period motion follows q̇
+    as the position's q̇·x/g does. The position is fitted again on the mismatch along the
+    corrected α (the model evaluated once more); below the entry t there, it is withheld.
+    (At 427.4 ft/s a 10 % α scale drew a 6.9 ± 1.1 ft position beside it.) ``mismatch`` is
+    the force mismatch as evaluated, before a named position's columns were taken out."""
+    offset = next((c for c in cands if c.selected and c.parameter == "x_accelerometer"), None)
+    scale = next((c for c in cands if c.selected and c.parameter == "scale_alpha"), None)
+    if offset is None or scale is None or "scale_alpha" in applied or "scale_alpha" not in kin.parameters:
+        return
+    along = model_along(_corrected(p, kin, {"scale_alpha": scale.estimate}), aircraft, ic, inertial_from=p).mismatch()
+    refit = cand.accelerometer_offset(p, {c: along[c] for c in ("CX", "CY", "CZ")}, noise)
+    t = max(abs(v) for v in refit.t)
+    if t >= cand.T_IN:
+        return
+    offset.selected = False
+    offset.details["sensor_rival"] = "scale_alpha"
+    offset.reason = (f"fitted, but not named: along the α corrected for the named scale_alpha = {scale.estimate:.3f} "
+                     f"the force mismatch no longer asks for it (x = {refit.position_ft[0]:.2f} ± "
+                     f"{refit.std_error_ft[0]:.2f} ft, largest |t| = {t:.1f})")
 
 
 def _kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool,
