@@ -567,6 +567,10 @@ def test_a_control_delay_the_kinematics_cannot_tell_from_a_gyro_skew_is_withheld
     assert not weak.selected and "does not rule out a lag of this size" in weak.reason
     assert ruled_out.selected and opposite.selected
     assert untested.selected and "q-gyro lag" in untested.details["not_ruled_out"]
+    from harness.diagnosis.run import _finding_dict
+    said = _finding_dict(untested, {}, {})
+    assert said["explanation"].endswith("Caveat: " + untested.details["not_ruled_out"] + ".")
+    assert said["evidence"]["not_ruled_out"] == untested.details["not_ruled_out"]
 
 
 def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():

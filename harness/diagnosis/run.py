@@ -642,6 +642,8 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
         text = template.format(**fmt)
     except (KeyError, ValueError):
         text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
+    if c.details.get("not_ruled_out"):  # an assumption the result rests on (analysis._withhold_skewed_delay)
+        text += f" Caveat: {c.details['not_ruled_out']}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
     if check is not None:
