@@ -191,9 +191,9 @@ def kinematic_alpha_rate(ch: dict[str, np.ndarray]) -> np.ndarray:
 
     (inertial: in gusts the air-relative α̇ differs by the gust's own rate). Built from the
     gyros and accelerometers, it carries their noise instead of the vane's: differentiating
-    the α record amplifies the vane noise within the common filter's band, by 20-100 % of
-    the signal on the outside sweep's pitch maneuvers (a low-amplitude frequency sweep at
-    500 ft/s: more noise than signal) against 5-20 % this way. A term fitted on the noisy
+    the α record amplifies the vane noise within the common filter's band: against noise-free
+    copies of the outside sweep's pitch maneuvers its error is 20-67 % of α̇'s RMS (109 % on a
+    half-amplitude frequency sweep at 500 ft/s: more noise than signal), this one's 5-21 %. A term fitted on the noisy
     derivative is attenuated (errors in variables), and a model evaluated along it passes
     the noise on through its own α̇ derivatives."""
     V, a, b = ch["V"], ch["alpha"], ch["beta"]

@@ -87,12 +87,13 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
 
 
 def local_maxima(P: np.ndarray) -> np.ndarray:
-    """Where the spectrum ``P`` stands above the ordinate below it and at least as high as
-    the one above: a mode's peak. The shoulder of the maneuver's own spectrum, falling
-    through the band's lower edge, is not one however far it stands above the running
-    median (which the quiet ordinates below the common filter's cut-off pull down)."""
+    """Where the spectrum ``P`` stands above the ordinates on either side: a mode's peak. The
+    shoulder of the maneuver's own spectrum, falling through the band's lower edge, is not
+    one however far it stands above the running median (which the quiet ordinates below the
+    common filter's cut-off pull down). A flat top counts once, at its middle
+    (:func:`scipy.signal.find_peaks`)."""
     out = np.zeros(P.size, dtype=bool)
-    out[1:-1] = (P[1:-1] > P[:-2]) & (P[1:-1] >= P[2:])
+    out[signal.find_peaks(P)[0]] = True
     return out
 
 
