@@ -603,3 +603,105 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
         bias, scale = pair(k, se)
         _scale_read_as_bias([bias, scale], p)
         assert bias.selected and not scale.selected
+
+
+def test_rms_margin_is_two_standard_errors_of_an_ar1_records_rms():
+    """run.rms_margin: 2/√(2 n_eff) with n_eff = N(1 − ρ)/(1 + ρ) (Bartlett). A seeded AR(1)
+    record with ρ = 0.6 and N = 20,000 has n_eff = 5,000 and a margin of 0.02; the lag-one
+    estimate's own error (√((1 − ρ²)/N) = 0.0057) moves it by under 2 %."""
+    from harness.diagnosis.run import rms_margin
+    rng = np.random.default_rng(12)
+    e = rng.standard_normal(20_000)
+    x = np.empty_like(e)
+    x[0] = e[0]
+    for i in range(1, x.size):
+        x[i] = 0.6 * x[i - 1] + e[i]
+    assert rms_margin(x) == pytest.approx(0.02, rel=0.03)
+    assert rms_margin(rng.standard_normal(20_000)) == pytest.approx(2 / np.sqrt(40_000), rel=0.03)
+
+
+@pytest.mark.parametrize("own, theirs, indistinct, change, expected", [
+    # the identification maneuver could not tell them apart: the rival must do worse by the margin
+    (1.00, 1.25, True, -0.6, True), (1.00, 1.35, True, -0.6, False),
+    # it set them apart and the validation supports the finding (drop 60 % > margin 30 %):
+    # only a rival better by more than the margin overturns it
+    (1.00, 0.99, False, -0.6, False), (1.00, 0.65, False, -0.6, True),
+    # it set them apart but the validation drop (10 %) is within the margin: any preference counts
+    (1.00, 0.99, False, -0.1, True), (1.00, 1.01, False, -0.1, False),
+])
+def test_a_rival_overturns_a_finding_by_the_validation_records_sampling_error(own, theirs, indistinct, change,
+                                                                              expected):
+    """run.rival_fits_as_well with a margin of 30 % (two standard errors of the RMS). Measured
+    cases: a C_m,α −0.15 at 18,000 ft / 420 ft/s, set apart from a moment-reference shift
+    (|t| 5.2 beside it), lowers the validation RMS by 70 % and the shift by 1 % more: the
+    finding stands. A C_m ΔV/V on a DHC-6 multisine null, set apart from a C_m α³, lowers
+    the validation RMS by 5 % against a 53 % margin: the α³'s 3 % better fit leaves it
+    ambiguous (it was a false finding when a distinct rival needed a significant win)."""
+    from harness.diagnosis.run import rival_fits_as_well
+    assert rival_fits_as_well(own, theirs, 0.30, indistinct, change) is expected
+
+
+def test_the_ambiguous_reason_says_which_rule_left_the_finding_undecided():
+    from harness.diagnosis.run import _ambiguous_reason
+    rival = {"parameter": "Cm_de", "correlation": -0.93, "noise_levels_own": 1.60, "noise_levels_rival": 1.59,
+             "margin": 0.41, "indistinct": ""}
+    text = _ambiguous_reason(rival, -0.15)
+    assert "Cm_de" in text and "lowers the validation RMS by 15 %, under the 41 %" in text
+    assert "better by more than 41 %" in _ambiguous_reason(rival | {"noise_levels_rival": 0.9}, -0.6)
+    assert "a difference under 41 %" in _ambiguous_reason(rival | {"indistinct": "t 3.1 beside it"}, -0.6)
+
+
+def test_a_change_of_lift_puts_minus_delta_cz_tan_alpha_on_cx():
+    """analysis.lift_change_on_cx: a lift change ΔC_L rotated into body axes is
+    ΔC_X = ΔC_L sin α, ΔC_Z = −ΔC_L cos α."""
+    from harness.diagnosis.analysis import lift_change_on_cx
+    alpha = np.linspace(-0.1, 0.4, 11)
+    d_cl = 0.6 * alpha + 0.01
+    assert np.allclose(lift_change_on_cx(-d_cl * np.cos(alpha), alpha), d_cl * np.sin(alpha), atol=1e-15)
+
+
+def _lift_case(extra_cx: float):
+    """A C_Z,α change of −0.6 concealed as a lift change at α 8.5° ± 2°, its C_X share
+    0.6 α sin α in C_X's mismatch, white noise 3e-4, plus ``extra_cx`` times a C_X column
+    of its own (a sinusoid the lift change does not follow)."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import Candidate
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    alpha = 0.148 + 0.035 * np.sin(2 * np.pi * 0.3 * t) * np.sin(2 * np.pi * 0.05 * t)
+    rng = np.random.default_rng(5)
+    own = np.sin(2 * np.pi * 0.7 * t)
+    cx = 0.6 * alpha * np.sin(alpha) + extra_cx * own + 3e-4 * rng.standard_normal(n)
+    cz = -0.6 * alpha * np.cos(alpha) + 3e-4 * rng.standard_normal(n)
+    term = lambda par, col: SimpleNamespace(parameter=par, column=col, scale=1.0)  # noqa: E731
+    a3 = (alpha - alpha.mean()) ** 3
+    slope = np.polyfit(alpha, cz, 1)[0]  # the C_Z,α change as the stepwise fits it (with a constant)
+    selections = {"CZ": (SimpleNamespace(names=("alpha",), params={"alpha": slope}), {"alpha": term("CZ_alpha", alpha)}),
+                  "CX": (SimpleNamespace(names=("alpha3", "own"), params={}),
+                         {"alpha3": term("CX_alpha3", a3), "own": term("CX_own", own)})}
+    cands = [Candidate("coefficient_error", "normal", "CZ", "CZ_alpha", -4.1, 0.08, -7.0, 0.5, "per rad",
+                       "stepwise on the CZ mismatch", True, "entered"),
+             Candidate("nonlinear_alpha", "axial", "CX", "CX_alpha3", 50.0, 9.0, 5.6, 0.1, "per rad^3",
+                       "stepwise on the CX mismatch", True, "entered"),
+             Candidate("coefficient_error", "axial", "CX", "CX_own", extra_cx, 1e-5, 50.0, 0.5, "1",
+                       "stepwise on the CX mismatch", bool(extra_cx), "entered")]
+    return cands, selections, {"CX": cx, "CZ": cz}, SimpleNamespace(smooth={"alpha": alpha}, dt=dt, n=n)
+
+
+def test_a_cx_term_that_a_named_lift_change_explains_is_withheld():
+    """analysis._withhold_explained_by_lift: the C_X α³ column takes the lift change's C_X
+    share at |t| >= 5 (10.2 here, 5.5 on the probe), and falls under the entry t once that
+    share is removed (4.6; the probe 3.4: the C_Z fit's straight line leaves cos α's
+    curvature); a C_X term the lift change does not explain stays named."""
+    from harness.diagnosis.analysis import _inner, _withhold_explained_by_lift
+    from estimators.colored_stepwise import colored_fit
+    cands, selections, mismatch, p = _lift_case(0.002)
+    inner = _inner(p)
+    cols = [selections["CX"][1][k].column[inner] for k in ("own", "alpha3")]
+    theta, se, _ = colored_fit(mismatch["CX"][inner], cols, ["own", "alpha3"])
+    assert abs(theta[1] / se[1]) >= 5.0  # the lift change alone makes the α³ term significant
+    _withhold_explained_by_lift(cands, selections, mismatch, p)
+    alpha3, own = cands[1], cands[2]
+    assert not alpha3.selected and "change of lift" in alpha3.reason
+    assert own.selected and own.reason == "entered"

@@ -121,6 +121,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         cands.append(_pinned_shift(step.pinned))
     # the rules that keep a term from being named when something else would imitate it
     _withhold_explained_by_cg(cands, step.selections, mismatch, p)
+    _withhold_explained_by_lift(cands, step.selections, mismatch, p)
     _withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
     _withhold_ambiguous(cands, kin, _imitation(p, kin, aircraft, ic, mismatch, step))
     if turbulent:
@@ -799,6 +800,50 @@ def _withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch
                 c.selected = False
                 c.reason = (f"entered, but explained by the moment-reference shift named on {cg.channel} "
                             f"({cg.estimate:.3g} ft): with its share of the {axis} mismatch removed, t = {t:.1f}")
+
+
+def lift_change_on_cx(delta_cz: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """The body-axis C_X that a change of lift carries when its C_Z share is ``delta_cz``:
+    C_X = −C_D cos α + C_L sin α and C_Z = −C_D sin α − C_L cos α, so ΔC_L alone gives
+    ΔC_Z = −ΔC_L cos α and ΔC_X = ΔC_L sin α = −ΔC_Z tan α."""
+    return -np.asarray(delta_cz, dtype=float) * np.tan(np.asarray(alpha, dtype=float))
+
+
+def _withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
+                                p: Prepared) -> None:
+    """A named C_Z term may be a change of *lift* (how an aerodynamic table usually carries
+    it, and how `models.hidden` conceals a C_Z error), which also puts −ΔC_Z tan α on C_X
+    (:func:`lift_change_on_cx`): at α ≈ 8.5° a C_Z,α change of −0.6 leaves a C_X mismatch
+    following α·sin α that the stepwise named as a C_X α³ (52 ± 9, t 5.5) on a probe at
+    6,000 ft and 380 ft/s. A C_X term is kept only if it stays significant (|t| >= the
+    entry t) with that share removed, as for a moment-reference shift's second axis."""
+    named = [c for c in cands if c.selected and c.channel == "CZ" and c.test == "stepwise on the CZ mismatch"]
+    if not named or "CZ" not in selections or "CX" not in selections:
+        return
+    sel_z, by_z = selections["CZ"]
+    keys = [k for k in sel_z.names if k in by_z and any(by_z[k].parameter == c.parameter for c in named)]
+    if not keys:
+        return
+    inner = _inner(p)
+    delta_cz = sum(sel_z.params[k] * by_z[k].column for k in keys)
+    z = mismatch["CX"][inner] - lift_change_on_cx(delta_cz, p.smooth["alpha"])[inner]
+    sel, by_key = selections["CX"]
+    chosen = [k for k in sel.names if k in by_key]
+    for c in cands:
+        key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
+        if not c.selected or c.channel != "CX" or key is None:
+            continue
+        others = [by_key[k].column[inner] for k in chosen if k != key]
+        try:
+            theta, se, _ = colored_fit(z, others + [by_key[key].column[inner]],
+                                       [f"o{i}" for i in range(len(others))] + [key])
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            continue
+        t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
+        if abs(t) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"entered, but explained by the C_Z change named ({', '.join(x.parameter for x in named)}) "
+                        f"read as a change of lift, whose share of C_X is −ΔC_Z tan α: with it removed, t = {t:.1f}")
 
 
 def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:

@@ -222,19 +222,30 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     ratio = sum(w[c] * after_rms[c] for c in axes) / max(sum(w[c] * before_rms[c] for c in axes), 1e-300)
     status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
     out = {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms, "change": ratio - 1.0}
-    rival = _rival_check(av, f, axes, {c: after[c][inner] for c in axes})
+    rival = _rival_check(av, f, axes, {c: after[c][inner] for c in axes}, ratio - 1.0)
     if rival is not None:
         out["rival"] = rival
         if status == "confirmed" and rival["fits_as_well"]:
             out["status"] = "ambiguous"
-            out["reason"] = (f"the validation maneuver is fitted about as well by {rival['parameter']} (its rival in "
-                             f"the identification fit: columns correlated {rival['correlation']:+.2f}; RMS "
-                             f"{rival['noise_levels_rival']:.3g} against {rival['noise_levels_own']:.3g} noise levels"
-                             + (f", a difference under {100 * rival['margin']:.0f} %, two standard errors of an RMS "
-                                f"of this record" if rival["margin"] else "") + ")")
+            out["reason"] = _ambiguous_reason(rival, ratio - 1.0)
         elif rival["indistinct"]:
             out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
     return out
+
+
+def _ambiguous_reason(rival: dict, change: float) -> str:
+    """Why a confirmed finding is left ``ambiguous`` by its rival (:func:`rival_fits_as_well`)."""
+    m = 100 * rival["margin"]
+    rms = f"RMS {rival['noise_levels_rival']:.3g} against {rival['noise_levels_own']:.3g} noise levels"
+    if rival["indistinct"]:
+        why = f"{rms}, a difference under {m:.0f} %, two standard errors of an RMS of this record"
+    elif change <= -rival["margin"]:
+        why = f"{rms}: better by more than {m:.0f} %, two standard errors of an RMS of this record"
+    else:
+        why = (f"{rms}; the finding itself lowers the validation RMS by {100 * -change:.0f} %, under the "
+               f"{m:.0f} % that two standard errors of an RMS of this record allow")
+    return (f"the validation maneuver is fitted about as well by {rival['parameter']} (its rival in the "
+            f"identification fit: columns correlated {rival['correlation']:+.2f}; {why})")
 
 
 def _undecided(f: Candidate) -> dict | None:
@@ -254,13 +265,38 @@ def rms_margin(residual: np.ndarray, z: float = 2.0) -> float:
     return z / np.sqrt(2.0 * n_eff)
 
 
-def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, np.ndarray]) -> dict | None:
+def rival_fits_as_well(own: float, theirs: float, margin: float, indistinct: bool, change: float) -> bool:
+    """Whether a finding's collinear rival predicts the validation maneuver as well as the
+    finding does, so that the finding is left ``ambiguous``.
+
+    Parameters
+    ----------
+    own, theirs : validation RMS of the mismatch with the finding's term, and with its rival's
+        in its place (each sized as fitted alone on the identification maneuver), in noise levels.
+    margin : two relative standard errors of the finding's validation RMS (:func:`rms_margin`).
+    indistinct : the identification maneuver could not tell the two apart (the term's |t|
+        beside its rival under the entry t).
+    change : the finding's own relative change of the validation RMS (negative: a drop).
+
+    A preference within the validation record's sampling error is no preference, so the
+    burden follows the identification maneuver's verdict: a rival it could not set apart
+    must do worse by more than ``margin`` for the finding to stand; one it did set apart
+    overturns the finding only by doing better by more than ``margin`` -- when the validation
+    maneuver supports the finding itself by more than ``margin``. Where the finding does not
+    lower the validation RMS by that much, the validation maneuver has no verdict of its own
+    on it and any preference for the rival leaves it ambiguous."""
+    if indistinct:
+        return theirs <= own * (1.0 + margin)
+    if change <= -margin:
+        return theirs <= own * (1.0 - margin)
+    return theirs <= own
+
+
+def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, np.ndarray],
+                 change: float) -> dict | None:
     """The finding's strongest collinear rival (``details['rival']``, :mod:`rivals`), sized
     as fitted in its place on the identification maneuver, predicting the same validation
-    axes: ``fits_as_well`` when its RMS there is no larger than the finding's. When the
-    identification maneuver could not tell the two apart (``indistinct``), the rival must do
-    worse by more than :func:`rms_margin` (two standard errors of the finding's RMS): a
-    preference within the validation record's own sampling error is then no preference."""
+    axes; ``fits_as_well`` by :func:`rival_fits_as_well`."""
     r = f.details.get("rival")
     if not r:
         return None
@@ -273,11 +309,12 @@ def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, n
     w = _noise_weights(av, axes)
     own = sum(w[c] * _rms(after[c]) for c in axes)
     theirs = sum(w[c] * rival_rms[c] for c in axes)
-    # the margin only where the identification maneuver could not tell the two apart
-    margin = max(rms_margin(after[c]) for c in axes) if r.get("indistinct") else 0.0
+    margin = max(rms_margin(after[c]) for c in axes)
+    indistinct = r.get("indistinct", "")
     return {"parameter": r["parameter"], "correlation": r["correlation"], "rms_after": rival_rms, "margin": margin,
             "noise_levels_own": own, "noise_levels_rival": theirs,
-            "fits_as_well": theirs <= own * (1.0 + margin), "indistinct": r.get("indistinct", "")}
+            "fits_as_well": rival_fits_as_well(own, theirs, margin, bool(indistinct), change),
+            "indistinct": indistinct}
 
 
 def _noise_weights(av: Analysis, axes: list[str]) -> dict[str, float]:
