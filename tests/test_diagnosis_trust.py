@@ -705,3 +705,43 @@ def test_a_cx_term_that_a_named_lift_change_explains_is_withheld():
     alpha3, own = cands[1], cands[2]
     assert not alpha3.selected and "change of lift" in alpha3.reason
     assert own.selected and own.reason == "entered"
+
+
+def _drift_case(along_vane_size: float, monkeypatch):
+    """A C_l ΔV/V term the stepwise entered along the inertial sideslip (size 0.004 in a
+    mismatch with white noise 2e-5), and the mismatch along the β vane: the same term times
+    ``along_vane_size`` / 0.004 plus the vane's wander through C_l,β (Gauss-Markov, 0.1°,
+    τ = 1 s, times −0.1/rad)."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis import analysis
+    from harness.diagnosis.analysis import Candidate
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    dv = 0.06 * np.sin(np.pi * t / t[-1]) ** 2
+    rng = np.random.default_rng(9)
+    wander = np.zeros(n)
+    for i in range(1, n):
+        wander[i] = wander[i - 1] * np.exp(-dt / 1.0) + 0.00175 * np.sqrt(1 - np.exp(-2 * dt)) * rng.standard_normal()
+    vane = along_vane_size * dv - 0.1 * wander + 2e-5 * rng.standard_normal(n)
+    monkeypatch.setattr(analysis, "inertial_beta", lambda p: True)
+    monkeypatch.setattr(analysis, "model_along", lambda *a, **k: SimpleNamespace(mismatch=lambda: {"Cl": vane}))
+    term = SimpleNamespace(parameter="Cl_dV", column=dv, scale=1.0)
+    step = SimpleNamespace(selections={"Cl": (SimpleNamespace(names=("dV",), params={"dV": 0.004}), {"dV": term})},
+                           nuisances={"Cl": {}})
+    c = Candidate("flight_condition_drift", "roll", "Cl", "Cl_dV", 0.004, 0.0002, 20.0, 0.5, "per unit dV/V",
+                  "stepwise on the Cl mismatch", True, "entered")
+    p = SimpleNamespace(dt=dt, n=n)
+    analysis._withhold_lateral_drift_off_the_vane([c], step, p, None, None)
+    return c
+
+
+def test_a_lateral_drift_term_the_beta_vane_does_not_show_is_withheld(monkeypatch):
+    """analysis._withhold_lateral_drift_off_the_vane: a C_l ΔV/V entered along the inertial
+    sideslip is refitted on the mismatch along the β vane. Where the vane's mismatch carries
+    it (0.004, under the vane's wander) it stays named; where it does not (the inertial
+    sideslip's own drift made it), it is withheld with the vane's t in its reason."""
+    kept = _drift_case(0.004, monkeypatch)
+    assert kept.selected and kept.reason == "entered"
+    withheld = _drift_case(0.0, monkeypatch)
+    assert not withheld.selected and "along the β vane's own record" in withheld.reason

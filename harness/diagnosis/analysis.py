@@ -122,6 +122,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # the rules that keep a term from being named when something else would imitate it
     _withhold_explained_by_cg(cands, step.selections, mismatch, p)
     _withhold_explained_by_lift(cands, step.selections, mismatch, p)
+    _withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     _withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
     _withhold_ambiguous(cands, kin, _imitation(p, kin, aircraft, ic, mismatch, step))
     if turbulent:
@@ -844,6 +845,45 @@ def _withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismat
             c.selected = False
             c.reason = (f"entered, but explained by the C_Z change named ({', '.join(x.parameter for x in named)}) "
                         f"read as a change of lift, whose share of C_X is −ΔC_Z tan α: with it removed, t = {t:.1f}")
+
+
+def _withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: _Stepwise, p: Prepared, aircraft: Aircraft,
+                                         ic: InitialCondition) -> None:
+    """A drift term on a lateral axis (C ∝ ΔV/V) is judged along the β vane as well.
+
+    The inertial sideslip the model follows (:func:`model_states`) is placed on the vane by a
+    constant and a trend; what drift its integration keeps beyond a trend follows whatever
+    else changes slowly, and reaches the lateral mismatch through the model's β slopes. A
+    slow term is exactly what it imitates: on a probe at 10,000 ft / 427.4 ft/s (stabilator
+    and rudder together, a C_n α·β of 2 making the aircraft dive 6 % faster) the inertial β
+    drifted by 0.04° with the airspeed (correlation −0.72) and C_l ΔV/V and C_n ΔV/V entered
+    at t −7.5 and 6.2 beside the right finding, where the noise-free flight's C_l mismatch
+    is zero. The vane has no such drift (its wander is zero-mean), so the term, refitted with
+    the axis's other entered terms and nuisances on the mismatch along the vane's own β, must
+    keep the entry t and its sign."""
+    chosen = [c for c in cands if c.selected and c.effect == "flight_condition_drift" and c.channel in cand.LAT]
+    if not chosen or not inertial_beta(p):
+        return
+    inner = _inner(p)
+    along_vane = model_along(p, aircraft, ic, vane_beta=True).mismatch()
+    for c in chosen:
+        sel, by_key = step.selections[c.channel]
+        names = [k for k in sel.names if k in by_key]
+        key = next((k for k in names if by_key[k].parameter == c.parameter), None)
+        if key is None:
+            continue
+        others = [by_key[k].column[inner] for k in names if k != key]
+        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
+        try:
+            theta, se, _ = colored_fit(along_vane[c.channel][inner], others + [by_key[key].column[inner]],
+                                       [f"o{i}" for i in range(len(others))] + [key])
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            continue
+        t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
+        if abs(t) < cand.T_IN or np.sign(theta[len(others)]) != np.sign(sel.params[key]):
+            c.selected = False
+            c.reason = (f"entered along the inertial sideslip, whose residual drift follows slow changes such as "
+                        f"the airspeed's; along the β vane's own record t = {t:.1f}")
 
 
 def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:
