@@ -354,7 +354,8 @@ def findings_table(findings: Sequence[Mapping]) -> Table:
                  "equation-error size is in findings.json's equation_error) while t stays the equation-error "
                  "test's. 'on validation': what the term, at its estimated size, does "
                  "to the validation maneuver's coefficient mismatch (confirmed: drops by 1 % or more; "
-                 "contradicted: grows, and the term is left out of the augmented model).")
+                 "contradicted: grows, and the term is left out of the augmented model; untested: that maneuver "
+                 "does not excite the term, which rests on the identification maneuver alone).")
 
 
 def evidence_table(findings: Sequence[Mapping]) -> Table | None:

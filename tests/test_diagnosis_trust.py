@@ -745,3 +745,26 @@ def test_a_lateral_drift_term_the_beta_vane_does_not_show_is_withheld(monkeypatc
     assert kept.selected and kept.reason == "entered"
     withheld = _drift_case(0.0, monkeypatch)
     assert not withheld.selected and "along the β vane's own record" in withheld.reason
+
+
+def test_a_validation_maneuver_that_does_not_excite_a_term_leaves_it_untested():
+    """run.untestable: a sequential three-axis maneuver drives α and β but not together, so an
+    α·β coupling is untested there while C_l,β is tested; on a stabilator-only maneuver (β, p,
+    r not driven) a C_l,β or C_n α·β finding is tested as before (a maneuver of another kind;
+    the noise it meets leaves the finding unconfirmed), and so is C_m,q̂."""
+    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.prepare import prepare
+    from harness.diagnosis.run import untestable
+
+    def finding(channel, parameter, effect="coefficient_error"):
+        return Candidate(effect, "roll", channel, parameter, 0.0, 1.0, 10.0, 0.5, "per rad",
+                         f"stepwise on the {channel} mismatch", True, "entered")
+    pitch = prepare(apply_noise(fly_maneuver(FlightSpec(input=stabilator_2112())), preset("realistic"), seed=5),
+                    "validation")
+    assert untestable(pitch, finding("Cl", "Cl_beta")) == ""
+    assert untestable(pitch, finding("Cn", "Cn_alpha_beta", "cross_coupling")) == ""
+    assert untestable(pitch, finding("Cm", "Cm_qhat")) == ""
+    three = prepare(apply_noise(fly_maneuver(FlightSpec(input=default_three_axis_input())), preset("realistic"),
+                                seed=6), "validation")
+    assert untestable(three, finding("Cl", "Cl_beta")) == ""
+    assert "never moved together" in untestable(three, finding("Cl", "Cl_alpha_beta", "cross_coupling"))

@@ -215,6 +215,9 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     axes = [c for c in COEFFICIENTS if n_terms[c]]
     if not axes:
         return None
+    why = untestable(av.prepared, f)
+    if why:
+        return {"status": "untested", "axes": axes, "reason": why}
     inner = _inner(av.prepared)
     before_rms = {c: _rms(av.mismatch[c][inner]) for c in axes}
     after_rms = {c: _rms(after[c][inner]) for c in axes}
@@ -231,6 +234,33 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
         elif rival["indistinct"]:
             out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
     return out
+
+
+def untestable(pv: Prepared, f: Candidate) -> str:
+    """Why the validation maneuver ``pv`` cannot test aerodynamic finding ``f`` ('' when it
+    can): it drove each of the term's states, but not as the term needs (an α·β coupling
+    where α and β never moved together, :func:`candidates.offered`). Predicted there, the
+    term's column is its regressors' noise, and the validation RMS would judge the noise,
+    not the term: a C_l α·β of −2 named at t −22 with the stabilator and rudder moved
+    together was 'contradicted' (+13 %) by a sequential validation maneuver along the α
+    vane's wander. Such a finding stands on the identification maneuver alone, as without a
+    validation maneuver, and says so.
+
+    A term on a state the validation maneuver did not drive at all is tested as before (and
+    left unconfirmed by the noise it meets): the two maneuvers are then of different kinds, and
+    the identification's own drive of that state may be incidental (on a lateral maneuver at
+    25,000 ft / 500 ft/s a C_Z,α entered at t 5.5 where α moved with the lateral motion;
+    passed untested, only the calibration in the loop withdrew it)."""
+    if f.channel not in COEFFICIENTS:
+        return ""
+    measured = {c: np.zeros(pv.n) for c in COEFFICIENTS}
+    term = next((t for t in cand.library(pv, f.channel, {}, measured) if t.parameter == f.parameter), None)
+    if term is None or not set(term.sources) <= set(pv.driven):
+        return ""
+    _, skipped = cand.offered(pv, [term])
+    if not skipped:
+        return ""
+    return f"the validation maneuver does not excite {f.parameter} ({skipped[0].details.get('not_offered', '')})"
 
 
 def _ambiguous_reason(rival: dict, change: float) -> str:
@@ -685,6 +715,8 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
     if check is not None:
         evidence["validation"] = check
+        if check["status"] == "untested":  # an assumption the result rests on: the identification alone
+            text += f" Not tested on the validation maneuver: {check['reason']}; it rests on the identification maneuver alone."
         if check["status"] == "contradicted" and "change" in check:
             text += (f" The validation maneuver contradicts it (its {', '.join(check['axes'])} mismatch grows by "
                      f"{100 * check['change']:.0f} % with the term), so it is not in the augmented model.")
@@ -1036,7 +1068,8 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         checks = {id(f): _undecided(f) for f in findings}
     # a finding is kept only when the validation maneuver confirms it (or cannot test it:
     # a gust level, a spectral peak); the others are reported apart, not as findings
-    unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"] != "confirmed"]
+    unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"]
+                   not in ("confirmed", "untested")]
     findings = [f for f in findings if f not in unconfirmed]
     modelled = list(findings)
     added = _terms_of(modelled, a.applied)
