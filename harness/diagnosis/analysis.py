@@ -771,6 +771,17 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
     return float(given) if given is not None else float(model_trim_thrust_lbf)
 
 
+def _refit_term(z: np.ndarray, others: list[np.ndarray], column: np.ndarray) -> tuple[float, float] | None:
+    """``column``'s coefficient and t fitted on ``z`` beside ``others`` and a constant (Eq. 5's
+    colored-residual standard error); None when the columns are dependent."""
+    try:
+        theta, se, _ = colored_fit(z, others + [column], [f"o{i}" for i in range(len(others))] + ["term"])
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return None
+    k = len(others)
+    return float(theta[k]), (float(theta[k] / se[k]) if se[k] > 0 else 0.0)
+
+
 def _withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
                               p: Prepared) -> None:
     """A moment-reference shift is one parameter acting on two axes (C_m through C_Z, C_n
@@ -790,13 +801,10 @@ def _withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch
             key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
             if not c.selected or c.channel != axis or key is None:
                 continue
-            others = [by_key[k].column[inner] for k in chosen if k != key]
-            try:
-                theta, se, _ = colored_fit(z, others + [by_key[key].column[inner]],
-                                           [f"o{i}" for i in range(len(others))] + [key])
-            except (SingularRegressorsError, np.linalg.LinAlgError):
+            fit = _refit_term(z, [by_key[k].column[inner] for k in chosen if k != key], by_key[key].column[inner])
+            if fit is None:
                 continue  # the term's column is dependent on the others: nothing to re-test
-            t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
+            t = fit[1]
             if abs(t) < cand.T_IN:
                 c.selected = False
                 c.reason = (f"entered, but explained by the moment-reference shift named on {cg.channel} "
@@ -834,13 +842,10 @@ def _withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismat
         key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
         if not c.selected or c.channel != "CX" or key is None:
             continue
-        others = [by_key[k].column[inner] for k in chosen if k != key]
-        try:
-            theta, se, _ = colored_fit(z, others + [by_key[key].column[inner]],
-                                       [f"o{i}" for i in range(len(others))] + [key])
-        except (SingularRegressorsError, np.linalg.LinAlgError):
+        fit = _refit_term(z, [by_key[k].column[inner] for k in chosen if k != key], by_key[key].column[inner])
+        if fit is None:
             continue
-        t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
+        t = fit[1]
         if abs(t) < cand.T_IN:
             c.selected = False
             c.reason = (f"entered, but explained by the C_Z change named ({', '.join(x.parameter for x in named)}) "
@@ -874,13 +879,11 @@ def _withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: _Stepwise
             continue
         others = [by_key[k].column[inner] for k in names if k != key]
         others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
-        try:
-            theta, se, _ = colored_fit(along_vane[c.channel][inner], others + [by_key[key].column[inner]],
-                                       [f"o{i}" for i in range(len(others))] + [key])
-        except (SingularRegressorsError, np.linalg.LinAlgError):
+        fit = _refit_term(along_vane[c.channel][inner], others, by_key[key].column[inner])
+        if fit is None:
             continue
-        t = theta[len(others)] / se[len(others)] if se[len(others)] > 0 else 0.0
-        if abs(t) < cand.T_IN or np.sign(theta[len(others)]) != np.sign(sel.params[key]):
+        size, t = fit
+        if abs(t) < cand.T_IN or np.sign(size) != np.sign(sel.params[key]):
             c.selected = False
             c.reason = (f"entered along the inertial sideslip, whose residual drift follows slow changes such as "
                         f"the airspeed's; along the β vane's own record t = {t:.1f}")
