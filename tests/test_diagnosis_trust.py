@@ -768,3 +768,41 @@ def test_a_validation_maneuver_that_does_not_excite_a_term_leaves_it_untested():
                                 seed=6), "validation")
     assert untestable(three, finding("Cl", "Cl_beta")) == ""
     assert "never moved together" in untestable(three, finding("Cl", "Cl_alpha_beta", "cross_coupling"))
+
+
+def _alpha_power_case(linear: float, cubic: float, monkeypatch):
+    """A C_m mismatch ``linear``·Δα + ``cubic``·Δα³ (Δα up to ±1.2°, white noise 5e-5) in
+    which the stepwise named an α³ term; the inertial α is the true one plus white noise
+    (0.01°)."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis import analysis
+    from harness.diagnosis.analysis import INERTIAL_CHANNELS, Candidate
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    rng = np.random.default_rng(21)
+    da = 0.021 * np.sin(2 * np.pi * 0.4 * t) * np.exp(-((t - 12) / 8) ** 2)
+    alpha = 0.09 + da
+    z = linear * da + cubic * da ** 3 + 5e-5 * rng.standard_normal(n)
+    inertial = alpha + 0.00017 * rng.standard_normal(n)
+    monkeypatch.setattr(analysis, "clean_channels", lambda p, names: {})
+    monkeypatch.setattr(analysis, "inertial_angles", lambda ch, p: {"alpha": inertial})
+    term = SimpleNamespace(parameter="Cm_alpha3", column=da ** 3, scale=1.0)
+    step = SimpleNamespace(selections={"Cm": (SimpleNamespace(names=("alpha3",), params={}), {"alpha3": term})},
+                           nuisances={"Cm": {}})
+    c = Candidate("nonlinear_alpha", "pitch", "Cm", "Cm_alpha3", -800.0, 40.0, -9.8, 0.5, "per rad^3",
+                  "stepwise on the Cm mismatch", True, "entered")
+    p = SimpleNamespace(dt=dt, n=n, smooth={k: alpha for k in INERTIAL_CHANNELS}, start={"alpha": 0.09})
+    analysis._withhold_alpha_power_off_the_inertial_alpha([c], step, p, {"Cm": z})
+    return c
+
+
+def test_an_alpha_power_the_inertial_alpha_calls_linear_is_withheld(monkeypatch):
+    """analysis._withhold_alpha_power_off_the_inertial_alpha: a C_m α³ named where the
+    mismatch is linear in α (a C_m,α change of −0.3) is withheld once both shapes are fitted
+    along the inertial α; a mismatch that is cubic (−800 per rad³, as large over the
+    maneuver) keeps it."""
+    linear = _alpha_power_case(-0.3, 0.0, monkeypatch)
+    assert not linear.selected and "inertial α" in linear.reason
+    cubic = _alpha_power_case(0.0, -800.0, monkeypatch)
+    assert cubic.selected and cubic.reason == "entered"

@@ -123,6 +123,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     _withhold_explained_by_cg(cands, step.selections, mismatch, p)
     _withhold_explained_by_lift(cands, step.selections, mismatch, p)
     _withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
+    _withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
     _withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
     _withhold_ambiguous(cands, kin, _imitation(p, kin, aircraft, ic, mismatch, step))
     if turbulent:
@@ -887,6 +888,42 @@ def _withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: _Stepwise
             c.selected = False
             c.reason = (f"entered along the inertial sideslip, whose residual drift follows slow changes such as "
                         f"the airspeed's; along the β vane's own record t = {t:.1f}")
+
+
+def _withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: _Stepwise, p: Prepared,
+                                                 mismatch: dict[str, np.ndarray]) -> None:
+    """A named α² or α³ term must stay significant beside the linear α term when both are
+    built on the inertial α (:func:`kinematics.inertial_angles`) rather than the vane's.
+
+    The columns are built on the vane's α, whose wander is errors in variables: the linear
+    column carries the wander in full and its coefficient is pulled toward zero, while a
+    power of the perturbation hardly carries it near trim, where the wander dominates. On
+    the package's T-37 (10,000 ft, 400 ft/s) and A4 (10,000 ft, 500 ft/s) a C_m,α change of
+    −0.3 was named as a C_m α³ (−824 ± 40 and −557 ± 27), though the noise-free flights'
+    mismatch is linear to 3e-7 and an α³ fits it a thousand times worse. The inertial α
+    carries the accelerometers' noise instead, which the vane term does not share; the
+    question asked of it is only which shape, with the axis's other entered terms and
+    nuisances beside both columns."""
+    chosen = [c for c in cands if c.selected and c.effect == "nonlinear_alpha" and c.channel in step.selections]
+    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
+        return
+    inner = _inner(p)
+    da = inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"]
+    for c in chosen:
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
+        if key is None:
+            continue
+        power = 2 if key == "alpha2" else 3
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k not in (key, "alpha")]
+        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
+        fit = _refit_term(mismatch[c.channel][inner], others + [da[inner]], da[inner] ** power)
+        if fit is None:
+            continue
+        if abs(fit[1]) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"entered, but beside the linear α term, both built on the inertial α (free of the vane's "
+                        f"wander, which favours a power of α), t = {fit[1]:.1f}")
 
 
 def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:
