@@ -677,7 +677,8 @@ def _lift_case(extra_cx: float):
     term = lambda par, col: SimpleNamespace(parameter=par, column=col, scale=1.0)  # noqa: E731
     a3 = (alpha - alpha.mean()) ** 3
     slope = np.polyfit(alpha, cz, 1)[0]  # the C_Z,α change as the stepwise fits it (with a constant)
-    selections = {"CZ": (SimpleNamespace(names=("alpha",), params={"alpha": slope}), {"alpha": term("CZ_alpha", alpha)}),
+    selections = {"CZ": (SimpleNamespace(names=("alpha",), params={"alpha": slope}),
+                         {"alpha": term("CZ_alpha", alpha)}),
                   "CX": (SimpleNamespace(names=("alpha3", "own"), params={}),
                          {"alpha3": term("CX_alpha3", a3), "own": term("CX_own", own)})}
     cands = [Candidate("coefficient_error", "normal", "CZ", "CZ_alpha", -4.1, 0.08, -7.0, 0.5, "per rad",

@@ -850,7 +850,8 @@ def _withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismat
         if abs(t) < cand.T_IN:
             c.selected = False
             c.reason = (f"entered, but explained by the C_Z change named ({', '.join(x.parameter for x in named)}) "
-                        f"read as a change of lift, whose share of C_X is −ΔC_Z tan α: with it removed, t = {t:.1f}")
+                        f"read as a change of lift, whose share of C_X is −ΔC_Z tan α: with it removed, "
+                        f"t = {t:.1f}")
 
 
 def _withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: _Stepwise, p: Prepared, aircraft: Aircraft,

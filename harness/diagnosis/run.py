@@ -716,7 +716,8 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
     if check is not None:
         evidence["validation"] = check
         if check["status"] == "untested":  # an assumption the result rests on: the identification alone
-            text += f" Not tested on the validation maneuver: {check['reason']}; it rests on the identification maneuver alone."
+            why = check["reason"]
+            text += f" {why[:1].upper()}{why[1:]}: it rests on the identification maneuver alone."
         if check["status"] == "contradicted" and "change" in check:
             text += (f" The validation maneuver contradicts it (its {', '.join(check['axes'])} mismatch grows by "
                      f"{100 * check['change']:.0f} % with the term), so it is not in the augmented model.")
@@ -1067,7 +1068,8 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         av = None
         checks = {id(f): _undecided(f) for f in findings}
     # a finding is kept only when the validation maneuver confirms it (or cannot test it:
-    # a gust level, a spectral peak); the others are reported apart, not as findings
+    # a gust level, a spectral peak, a coupling it does not excite, :func:`untestable`);
+    # the others are reported apart, not as findings
     unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"]
                    not in ("confirmed", "untested")]
     findings = [f for f in findings if f not in unconfirmed]
