@@ -333,8 +333,20 @@ def test_the_maneuvers_own_shoulder_through_the_band_edge_is_no_mode(monkeypatch
     mode = spectra.structural_peak(record(q + 0.003 * np.sin(2 * np.pi * 8.0 * np.arange(n) / fs)))
     assert mode.p_value < spectra.FISHER_P and abs(mode.frequency_hz - 8.0) < 0.25
     monkeypatch.setattr(spectra, "local_maxima", lambda P: np.ones(P.size, dtype=bool))
-    edge = spectra.structural_peak(p)  # without the rule, the shoulder is a 'mode' at the edge
+    monkeypatch.setattr(spectra, "peak_ratios", lambda P, med, idx: P[idx] / med[idx])
+    edge = spectra.structural_peak(p)  # without the rules, the shoulder is a 'mode' at the edge
     assert edge.p_value < spectra.FISHER_P and edge.frequency_hz < 2.6
+
+
+def test_a_ripple_on_the_shoulder_stands_on_its_base_not_above_it():
+    """spectra.peak_ratios on a made-up spectrum: a ripple on the falling shoulder is a local
+    maximum 3.7 times the median (the quiet floor) but only 1.1 times its base, the valley on
+    its low side; a mode rising 10 times from a flat floor is 10 times both."""
+    from harness.diagnosis import spectra
+    P = np.array([10.0, 5.0, 1.0, 1.1, 0.3, 0.3, 0.3, 3.0, 0.3, 0.3])
+    med = np.full(P.size, 0.3)
+    ratios = spectra.peak_ratios(P, med, np.array([3, 7]))
+    assert ratios[0] == pytest.approx(1.1) and ratios[1] == pytest.approx(10.0)
 
 
 def test_kinematic_alpha_rate_is_exact_for_rigid_body_motion():

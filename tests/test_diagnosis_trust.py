@@ -578,8 +578,10 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     which the kinematic fit gives as a bias. With ᾱ 0.12 rad (0.011 of it the bias) a bias
     of 0.011 ± 0.0008 rad says k = 0.100 ± 0.007, and the scale tried beside it says
     0.086 ± 0.022 (t 3.9): one scale, named at their inverse-variance mean, the bias read as
-    its offset. A scale of the other sign, one far from it, or one the kinematics do not
-    suspect (t under 2.5) leaves the bias named."""
+    its offset. A scale of the other sign, or one the kinematics do not suspect (t under
+    2.5), leaves the bias named; one of the same sign the excursions show (t >= 3) but far
+    from the offset's k leaves neither named (analysis._withhold_bias_beside_a_scale: bias,
+    scale or both)."""
     from types import SimpleNamespace
 
     from harness.diagnosis.analysis import Candidate, _scale_read_as_bias
@@ -599,10 +601,43 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     assert scale.selected and not bias.selected and bias.details["read_as"] == "scale_alpha"
     assert scale.estimate == pytest.approx(expected) and scale.std_error == pytest.approx(1 / np.sqrt(w.sum()))
     assert scale.details["corroboration"] == {"named": True, "kinematic": 0.086, "kinematic_std": 0.022}
-    for k, se in ((-0.086, 0.022), (0.30, 0.03), (0.05, 0.022)):
+    for k, se in ((-0.086, 0.022), (0.05, 0.022)):
         bias, scale = pair(k, se)
         _scale_read_as_bias([bias, scale], p)
         assert bias.selected and not scale.selected
+    bias, scale = pair(0.30, 0.03)
+    _scale_read_as_bias([bias, scale], p)
+    assert not bias.selected and not scale.selected
+    assert bias.details["scale_rival"]["offset_k"] == pytest.approx(0.1)
+    assert bias.details["as_scale"]["k"] == pytest.approx(0.1)  # the reading the validation test uses
+
+
+def test_a_scale_named_on_its_offset_is_tested_the_same_way_on_the_validation_maneuver():
+    """run._offset_scale_check: a scale named on its offset and excursions together is
+    confirmed where the validation maneuver's offset (read as k = b/x̄_true, 0.12 ± 0.013)
+    and excursions (0.048 ± 0.036, t 1.3: 'neutral' alone) agree: their inverse-variance
+    mean, t >= 3 with the same sign. Where they disagree there is no verdict."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.run import _offset_scale_check, _sensor_check
+
+    def validation(k_exc, se_exc):
+        bias = Candidate("sensor_bias", None, "alpha", "bias_alpha", 0.0068, 0.00074, 9.2, 0.0, "rad",
+                         "kinematic consistency", True, "", {"as_scale": {"k": 0.12, "k_std": 0.013}})
+        twin = Candidate("sensor_scale", None, "alpha", "scale_alpha", k_exc, se_exc, k_exc / se_exc, 0.0, "1",
+                         "kinematic consistency", False, "below the entry t")
+        return SimpleNamespace(candidates=[bias, twin]), twin
+
+    found = Candidate("sensor_scale", None, "alpha", "scale_alpha", 0.101, 0.0068, 14.8, 0.0, "1",
+                      "kinematic consistency", True, "", {"offset": {"k": 0.100}})
+    av, twin = validation(0.048, 0.036)
+    check = _sensor_check(av, found)
+    w = np.array([1 / 0.013 ** 2, 1 / 0.036 ** 2])
+    assert check["status"] == "confirmed"
+    assert check["estimate"] == pytest.approx(np.dot(w, [0.12, 0.048]) / w.sum())
+    av, twin = validation(-0.05, 0.02)  # the excursions disagree with the offset
+    assert _offset_scale_check(av, found, twin) is None and _sensor_check(av, found)["status"] == "neutral"
 
 
 def test_rms_margin_is_two_standard_errors_of_an_ar1_records_rms():

@@ -311,24 +311,30 @@ def _scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
     0.47° bias ahead of the scale the kinematics had named.) A scale the kinematics had not
     named is judged on the validation maneuver as a finding named on two tests
     (``details['corroboration']``: its kinematic k, same sign, |t| >= 2, within two standard
-    errors)."""
+    errors). Every bias of α or V carries its reading as a scale, b/x̄_true
+    (``details['as_scale']``), for that validation test (``run._offset_scale_check``)."""
     for channel in OFFSET_SCALE_CHANNELS:
-        bias = next((c for c in cands if c.selected and c.parameter == f"bias_{channel}"), None)
+        biases = [c for c in cands if c.parameter == f"bias_{channel}"]
+        bias = next((c for c in biases if c.selected), biases[0] if biases else None)
         scale = next((c for c in cands if c.parameter == f"scale_{channel}"), None)
-        if bias is None or scale is None or abs(scale.t) < AMBIGUOUS_T or channel not in p.smooth:
+        if bias is None or channel not in p.smooth:
             continue
         x_true = float(np.mean(p.smooth[channel])) - bias.estimate
         if abs(x_true) <= 0.0:
             continue
         k_off, se_off = bias.estimate / x_true, bias.std_error / abs(x_true)
+        bias.details["as_scale"] = {"k": k_off, "k_std": se_off, "mean_true": x_true}
+        if not bias.selected or scale is None or abs(scale.t) < AMBIGUOUS_T:
+            continue
+        V_mean = float(np.mean(p.smooth["V"]))
         if np.sign(k_off) != np.sign(scale.estimate) or \
                 abs(k_off - scale.estimate) > 2.0 * np.hypot(se_off, scale.std_error):
+            _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, V_mean)
             continue
         k_exc, se_exc, named = scale.estimate, scale.std_error, scale.selected
         w = np.array([1.0 / se_off ** 2, 1.0 / se_exc ** 2])
         k = float(np.dot(w, [k_off, k_exc]) / w.sum())
         se = float(1.0 / np.sqrt(w.sum()))
-        V_mean = float(np.mean(p.smooth["V"]))
         if not (is_plausible(scale.parameter, k, V_mean) and is_practical(scale.parameter, k, p.dt)):
             continue
         scale.estimate, scale.std_error, scale.t, scale.selected = k, se, k / se, True
@@ -341,6 +347,27 @@ def _scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
         bias.selected = False
         bias.details["read_as"] = scale.parameter
         bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
+
+
+def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: float, se_off: float,
+                                  V_mean: float) -> None:
+    """Withhold a bias of α or V beside a scale of the same instrument that its excursions
+    show (kinematic |t| >= :data:`APPLY_T`, not named) with the sign the offset, read as a
+    scale (k = b/x̄_true, plausible), has, when the two do not agree on one scale factor
+    (:func:`_scale_read_as_bias`): a scale makes an offset k·x̄ as well, so the record
+    cannot say whether the offset is a bias, the scale's, or both. (An F-16 at 420 ft/s with
+    a 10 % α-vane scale, on a pitch multisine: its coefficient means gave an offset of
+    0.50° = 0.105 ± 0.003 of the mean α, its excursions k = 0.072 ± 0.012 (t 5.9); it was
+    named a 0.50° α bias.)"""
+    if scale.selected or abs(scale.t) < APPLY_T or np.sign(scale.estimate) != np.sign(k_off) \
+            or not is_plausible(scale.parameter, k_off, V_mean):
+        return
+    bias.selected = False
+    bias.details["scale_rival"] = {"parameter": scale.parameter, "offset_k": k_off, "offset_k_std": se_off,
+                                   "excursion_k": scale.estimate, "excursion_k_std": scale.std_error}
+    bias.reason = (f"entered, but not named: {scale.parameter} would make an offset too, and the excursions show one "
+                   f"(k = {scale.estimate:.3f} ± {scale.std_error:.3f}, t = {scale.t:.1f}) that does not agree with "
+                   f"the offset read as a scale (k = {k_off:.3f} ± {se_off:.3f}): bias, scale or both")
 
 
 def _withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResult, p: Prepared,

@@ -380,6 +380,9 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
     status = _same_instrument_status(twin.estimate, twin.t, f.estimate)
     out = {"status": status, "axes": [], "estimate": float(twin.estimate), "std_error": float(twin.std_error),
            "t": float(twin.t)}
+    if status == "neutral" and "offset" in f.details and "offset" not in twin.details:
+        out = _offset_scale_check(av, f, twin) or out
+        status = out["status"]
     kin = f.details.get("corroboration") or {}
     if status == "neutral" and kin.get("named") and same and abs(twin.t) >= CORROBORATED_CONFIRM_T:
         # named on two tests, each below the kinematic entry alone: the validation maneuver's
@@ -390,6 +393,32 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
                     f"{CORROBORATED_CONFIRM_T:g} and within two standard errors of the identification's kinematic "
                     f"estimate ({kin['kinematic']:.4g} ± {kin['kinematic_std']:.2g})"}
     return out
+
+
+def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | None:
+    """A scale factor named on its offset and its excursions together
+    (:func:`analysis._scale_read_as_bias`), tested the same way on the validation maneuver:
+    there too the offset at the mean (its bias read as k = b/x̄_true) and the excursions
+    (the kinematic k, ``twin``) must agree within two standard errors; their
+    inverse-variance mean is then the validation maneuver's estimate, judged as any sensor
+    finding's (:func:`_same_instrument_status`). None when they disagree or there is no
+    offset reading. (An F-16 at 22,000 ft and 600 ft/s with a 10 % α-vane scale: named at
+    0.101 ± 0.007; the validation maneuver's excursions alone gave 0.048 ± 0.036, t 1.3,
+    its offset 0.12 ± 0.013.)"""
+    channel = f.parameter.split("_", 1)[1]
+    reading = next((c.details["as_scale"] for c in av.candidates
+                    if c.parameter == f"bias_{channel}" and "as_scale" in c.details), None)
+    if reading is None or not twin.std_error > 0:
+        return None
+    k_off, se_off = reading["k"], reading["k_std"]
+    if abs(k_off - twin.estimate) > 2.0 * np.hypot(se_off, twin.std_error):
+        return None
+    w = np.array([1.0 / se_off ** 2, 1.0 / twin.std_error ** 2])
+    k = float(np.dot(w, [k_off, twin.estimate]) / w.sum())
+    se = float(1.0 / np.sqrt(w.sum()))
+    return {"status": _same_instrument_status(k, k / se, f.estimate), "axes": [], "estimate": k, "std_error": se,
+            "t": k / se, "rule": f"the offset at the mean {channel} (k = {k_off:.3f} ± {se_off:.3f}) and the "
+            f"excursions (k = {twin.estimate:.3f} ± {twin.std_error:.3f}) agree"}
 
 
 def _vane_means_check(av: Analysis, f: Candidate) -> dict:
