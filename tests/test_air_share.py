@@ -1,5 +1,5 @@
 """Gusts or vane error: the air-share test (harness.diagnosis.spectra.air_share) and the
-verdict it gives the diagnosis (analysis.gust_verdict), pinned to constructed records whose
+verdict it gives the diagnosis (gust_rules.gust_verdict), pinned to constructed records whose
 split between air and vane error is known."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from harness.diagnosis.analysis import AIR_SHARE_MIN, AIR_T, gust_verdict, vane_wander
+from harness.diagnosis.gust_rules import AIR_SHARE_MIN, AIR_T, gust_verdict, vane_wander
 from harness.diagnosis.spectra import GUST_HIGHPASS_HZ, AirShare, air_share
 
 N, DT = 3000, 0.02

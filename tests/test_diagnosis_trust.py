@@ -135,7 +135,7 @@ def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
     """run._unsupported_in_the_loop: a used calibration that sizes a named term within 3
     standard errors of no change withdraws it (status 'unsupported', the validation status
     kept beside it); a term it sizes clearly, or an unused calibration, withdraws nothing."""
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.run import CALIBRATED_MIN_Z, _unsupported_in_the_loop
 
     def cand(parameter, estimate):
@@ -168,7 +168,7 @@ def test_the_model_mass_assumption_names_how_far_the_recording_is():
 
 
 def test_gusts_too_light_to_name_void_the_sensor_tests_on_a_slow_aircraft():
-    """analysis.light_gusts: the same 1.9 ft/s gust is 0.6 deg at 180 ft/s (six times a
+    """gust_rules.light_gusts: the same 1.9 ft/s gust is 0.6 deg at 180 ft/s (six times a
     0.1 deg vane's noise: the sensor tests are off, and the reason says why) and 0.15 deg at
     700 ft/s (1.5 times: they stand); a kinematic residual at the noise's level, or a
     noise-free recording's 0.04 ft/s, is no gust."""
@@ -176,7 +176,7 @@ def test_gusts_too_light_to_name_void_the_sensor_tests_on_a_slow_aircraft():
 
     import numpy as np
 
-    from harness.diagnosis.analysis import GUST_ANGLE_FACTOR, GUST_RATIO, light_gusts
+    from harness.diagnosis.gust_rules import GUST_ANGLE_FACTOR, GUST_RATIO, light_gusts
     vane = np.radians(0.1)
     p = SimpleNamespace(noise_std={"alpha": vane, "beta": vane})
     gust = SimpleNamespace(sigma_w_fps=1.9, sigma_v_fps=1.2, ratio_to_noise=12.9)
@@ -251,27 +251,27 @@ def test_vanes_at_the_positions_the_metadata_give_are_carried_to_the_cg():
 
 
 def test_the_kinematics_refute_a_vane_scale_they_do_not_see():
-    """analysis._kinematics_refute: a C_Z,α error looks like an α-vane scale to the coefficient
+    """sensor_rules.kinematics_refute: a C_Z,α error looks like an α-vane scale to the coefficient
     mismatch alone; the kinematics' own estimate of that scale, 4.5 combined standard errors
     away (the project sweep's C_Z,α case), refutes it; 2.5 apart (a true 0.08 scale at 700
     ft/s) does not; nor does a scale the kinematics never tried."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import VANE_REFUTE_Z, _kinematics_refute
+    from harness.diagnosis.sensor_rules import VANE_REFUTE_Z, kinematics_refute
 
     def kin(v, se):
         term = SimpleNamespace(name="scale_alpha", estimate=v, t=v / se)
         return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[term]))
     assert VANE_REFUTE_Z == 3.5
-    why = _kinematics_refute(kin(0.0033, 0.011), "scale_alpha", -0.069, 0.0115)
+    why = kinematics_refute(kin(0.0033, 0.011), "scale_alpha", -0.069, 0.0115)
     assert "kinematics put that scale at 0.003" in why
-    assert _kinematics_refute(kin(0.066, 0.032), "scale_alpha", 0.166, 0.024) == ""
-    assert _kinematics_refute(SimpleNamespace(selection=SimpleNamespace(params={}, terms=[])), "scale_alpha",
+    assert kinematics_refute(kin(0.066, 0.032), "scale_alpha", 0.166, 0.024) == ""
+    assert kinematics_refute(SimpleNamespace(selection=SimpleNamespace(params={}, terms=[])), "scale_alpha",
                               -0.069, 0.0115) == ""
 
 
 def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypatch):
-    """analysis.name_replicated: the same instrument flew both maneuvers, so an a_z bias the
+    """sensor_naming.name_replicated: the same instrument flew both maneuvers, so an a_z bias the
     identification's kinematics put at 0.027 ± 0.0058 (t 4.7) and the validation's at
     0.027 ± 0.0042 (t 6.3 there, but below the entry t on the identification) is named at
     their inverse-variance combination; opposite signs, sizes more than two standard errors
@@ -280,11 +280,12 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
     error is named."""
     from types import SimpleNamespace
 
-    from harness.diagnosis import analysis as an
-    from harness.diagnosis.analysis import Candidate, name_replicated
-    monkeypatch.setattr(an, "_kinematics_trusted", lambda a: True)
-    monkeypatch.setattr(an, "_kinematic_rival", lambda kin, name: None)
-    monkeypatch.setattr(an, "_sensor_verdict", lambda *args: (True, ""))
+    from harness.diagnosis import sensor_naming
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_naming import name_replicated
+    monkeypatch.setattr(sensor_naming, "_kinematics_trusted", lambda a: True)
+    monkeypatch.setattr(sensor_naming, "kinematic_rival", lambda kin, name: None)
+    monkeypatch.setattr(sensor_naming, "sensor_verdict", lambda *args: (True, ""))
 
     def analysis(v, se):
         c = Candidate("sensor_bias", None, "az", "bias_az", v, se, v / se, 0.0, "g", "kinematic consistency",
@@ -376,7 +377,7 @@ def test_surfaces_not_recorded_are_named_with_what_stood_in_for_them():
 
 
 def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
-    """analysis._name_vane_bias_from_means on the project sweep's β-vane bias of 1° (1.05° in
+    """sensor_naming.name_vane_bias_from_means on the project sweep's β-vane bias of 1° (1.05° in
     the recording with the noise layer's own 0.05°): the kinematics hardly see it (t 1.5),
     the lateral means along the vane do, on C_Y, C_l and C_n alike; the validation maneuver
     (pitch only, β never driven) shows the same bias on its own means, and the augmented
@@ -401,7 +402,7 @@ def test_a_sensor_finding_the_validation_contradicts_says_what_the_same_test_gav
     """run._finding_dict: a sensor test's check carries no mismatch 'change' (a KeyError, an
     internal error, before); the text gives the estimate the same test made on the
     validation maneuver."""
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.run import _finding_dict
     f = Candidate("sensor_bias", None, "beta", "bias_beta", 0.0184, 6e-5, 300.0, 0.0, "rad",
                   "lateral coefficient means along the β vane", selected=True)
@@ -412,14 +413,16 @@ def test_a_sensor_finding_the_validation_contradicts_says_what_the_same_test_gav
 
 
 def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
-    """analysis._withhold_ambiguous: a q-scale the kinematics suspect (t 2.6) withholds a
+    """term_rules.withhold_ambiguous: a q-scale the kinematics suspect (t 2.6) withholds a
     C_m,q̂ change only when, at a size they allow, it would imitate at least half of it
-    (``imitated``, analysis._imitation); a change far beyond that is kept, with the suspect
+    (``imitated``, term_rules.imitation); a change far beyond that is kept, with the suspect
     and its reach in ``details['sensor_suspect']``; where the imitation cannot be computed
     the term stays withheld."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import IMITATION_SHARE, Candidate, _withhold_ambiguous
+    from harness.diagnosis.evidence import Candidate
+
+    from harness.diagnosis.term_rules import IMITATION_SHARE, withhold_ambiguous
     kin = SimpleNamespace(parameters={"scale_q": SimpleNamespace(channel="q")},
                           selection=SimpleNamespace(params={}, terms=[SimpleNamespace(name="scale_q", estimate=-0.023,
                                                                                       t=-2.6)]))
@@ -429,9 +432,9 @@ def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
                          "stepwise on the Cm mismatch", selected=True, reason="entered", details={"change": -5.9})
 
     kept, withheld, unknown = term(), term(), term()
-    _withhold_ambiguous([kept], kin, lambda c, name: 0.05)
-    _withhold_ambiguous([withheld], kin, lambda c, name: IMITATION_SHARE * 5.9)
-    _withhold_ambiguous([unknown], kin, lambda c, name: None)
+    withhold_ambiguous([kept], kin, lambda c, name: 0.05)
+    withhold_ambiguous([withheld], kin, lambda c, name: IMITATION_SHARE * 5.9)
+    withhold_ambiguous([unknown], kin, lambda c, name: None)
     assert kept.selected and kept.details["sensor_suspect"] == {"parameter": "scale_q", "imitates_at_most": 0.05,
                                                                 "change": 5.9}
     assert kept.reason == "entered; the kinematics suspect scale_q (t = 2.6), which would imitate at most 0.05 of " \
@@ -441,7 +444,7 @@ def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
 
 
 def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the_mismatch(monkeypatch):
-    """analysis._vane_noise_columns: the column −C_m,α·e (e = −w_gust/V from the kinematic
+    """stepwise_axes.vane_noise_columns: the column −C_m,α·e (e = −w_gust/V from the kinematic
     residual) is offered to C_m's fit when, fitted alone, it takes at least VANE_NOISE_SHARE
     off the mismatch RMS (a mismatch that is mostly the vane's error passed through C_m,α),
     not when the mismatch is something else, nor when α is held at its start."""
@@ -449,26 +452,26 @@ def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the
 
     import numpy as np
 
-    from harness.diagnosis import analysis
+    from harness.diagnosis import stepwise_axes
     rng = np.random.default_rng(7)
     n, V0 = 1500, 180.0
     w = rng.standard_normal(n)                        # the "gust": V times the vane-minus-inertial angle
-    monkeypatch.setattr(analysis, "_turbulence", lambda p: (SimpleNamespace(w_fps=w), False))
+    monkeypatch.setattr(stepwise_axes, "turbulence_test", lambda p: (SimpleNamespace(w_fps=w), False))
     p = SimpleNamespace(dt=0.02, n=n)
     along = SimpleNamespace(states={"alpha": np.linspace(0.0, 0.02, n)})
     slope = np.full(n, -1.2)
     column = slope * w / V0                            # −C_m,α·e with e = −w/V
     vane_made = {"Cm": 0.9 * column + 0.3 * np.std(column) * rng.standard_normal(n)}
     other = {"Cm": np.std(column) * rng.standard_normal(n)}
-    got = analysis._vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, vane_made)
+    got = stepwise_axes.vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, vane_made)
     assert set(got) == {"Cm"} and np.allclose(got["Cm"], column)
-    assert analysis._vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, other) == {}
+    assert stepwise_axes.vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, other) == {}
     held = SimpleNamespace(states={"alpha": np.zeros(n)})
-    assert analysis._vane_noise_columns(p, held, lambda x: {"Cm": slope}, V0, vane_made) == {}
+    assert stepwise_axes.vane_noise_columns(p, held, lambda x: {"Cm": slope}, V0, vane_made) == {}
 
 
 def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
-    """analysis._cg_mean_test: a shift Δx moves C_m by Δx·C_Z/c̄, its mean too. The shift a
+    """stepwise_axes._cg_mean_test: a shift Δx moves C_m by Δx·C_Z/c̄, its mean too. The shift a
     lateral C_n fit suggests (C_n ∝ C_Y looks like C_n,β) is refuted when C_m's constant
     falls short of Δx·mean(C_Z)/c̄ by more than CG_MEAN_SHARE of it and CG_MEAN_Z standard
     errors; the shift's own mistrim, or a larger one of the same sign, supports it. A short
@@ -477,7 +480,7 @@ def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
 
     import numpy as np
 
-    from harness.diagnosis.analysis import CG_MEAN_SHARE, _cg_mean_test
+    from harness.diagnosis.stepwise_axes import CG_MEAN_SHARE, _cg_mean_test
     rng = np.random.default_rng(3)
     n, cbar, b, dx = 1500, 11.32, 30.0, 0.6
     CZ = -0.5 + 0.01 * np.sin(np.linspace(0.0, 20.0, n))
@@ -514,7 +517,7 @@ def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematic
     vane, which reads as a bias at the trim α."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.run import SENSOR_CONFIRM_T, _vane_means_check
     named = Candidate("sensor_bias", "lon", "alpha", "bias_alpha", 0.0173, 0.0006, 28.0, 0.0, "rad",
                       "longitudinal coefficient means along the α vane", True)
@@ -537,7 +540,7 @@ def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematic
 
 
 def test_a_control_delay_the_kinematics_cannot_tell_from_a_gyro_skew_is_withheld():
-    """analysis._withhold_skewed_delay: a delay is named only when the kinematics rule out a
+    """term_rules._withhold_skewed_delay: a delay is named only when the kinematics rule out a
     lag of the rate its surface drives of the same size. The kinematics' q skew of
     0.057 ± 0.015 s (t 3.8, an F-16 multisine with a 40 ms q skew) and a weak 0.055 ± 0.026 s
     (t 2.1, a 737 aileron sweep with a 40 ms p skew) both lie within two standard errors of
@@ -546,7 +549,9 @@ def test_a_control_delay_the_kinematics_cannot_tell_from_a_gyro_skew_is_withheld
     caveat."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import Candidate, _withhold_skewed_delay
+    from harness.diagnosis.evidence import Candidate
+
+    from harness.diagnosis.term_rules import _withhold_skewed_delay
 
     def kin(skew, se):
         return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[SimpleNamespace(
@@ -574,17 +579,19 @@ def test_a_control_delay_the_kinematics_cannot_tell_from_a_gyro_skew_is_withheld
 
 
 def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
-    """analysis._scale_read_as_bias: an α reading (1 + k)·α stands k·ᾱ off at the mean α,
+    """sensor_rules.scale_read_as_bias: an α reading (1 + k)·α stands k·ᾱ off at the mean α,
     which the kinematic fit gives as a bias. With ᾱ 0.12 rad (0.011 of it the bias) a bias
     of 0.011 ± 0.0008 rad says k = 0.100 ± 0.007, and the scale tried beside it says
     0.086 ± 0.022 (t 3.9): one scale, named at their inverse-variance mean, the bias read as
     its offset. A scale of the other sign, or one the kinematics do not suspect (t under
     2.5), leaves the bias named; one of the same sign the excursions show (t >= 3) but far
-    from the offset's k leaves neither named (analysis._withhold_bias_beside_a_scale: bias,
+    from the offset's k leaves neither named (sensor_rules._withhold_bias_beside_a_scale: bias,
     scale or both)."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import Candidate, _scale_read_as_bias
+    from harness.diagnosis.evidence import Candidate
+
+    from harness.diagnosis.sensor_rules import scale_read_as_bias
     p = SimpleNamespace(smooth={"alpha": np.full(100, 0.121), "V": np.full(100, 450.0)}, dt=0.02)
 
     def pair(k, se_k):
@@ -595,7 +602,7 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
         return bias, scale
 
     bias, scale = pair(0.086, 0.022)
-    _scale_read_as_bias([bias, scale], p)
+    scale_read_as_bias([bias, scale], p)
     w = np.array([1 / (0.0008 / 0.11) ** 2, 1 / 0.022 ** 2])
     expected = float(np.dot(w, [0.1, 0.086]) / w.sum())
     assert scale.selected and not bias.selected and bias.details["read_as"] == "scale_alpha"
@@ -603,10 +610,10 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     assert scale.details["corroboration"] == {"named": True, "kinematic": 0.086, "kinematic_std": 0.022}
     for k, se in ((-0.086, 0.022), (0.05, 0.022)):
         bias, scale = pair(k, se)
-        _scale_read_as_bias([bias, scale], p)
+        scale_read_as_bias([bias, scale], p)
         assert bias.selected and not scale.selected
     bias, scale = pair(0.30, 0.03)
-    _scale_read_as_bias([bias, scale], p)
+    scale_read_as_bias([bias, scale], p)
     assert not bias.selected and not scale.selected
     assert bias.details["scale_rival"]["offset_k"] == pytest.approx(0.1)
     assert bias.details["as_scale"]["k"] == pytest.approx(0.1)  # the reading the validation test uses
@@ -619,7 +626,7 @@ def test_a_scale_named_on_its_offset_is_tested_the_same_way_on_the_validation_ma
     mean, t >= 3 with the same sign. Where they disagree there is no verdict."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.run import _offset_scale_check, _sensor_check
 
     def validation(k_exc, se_exc):
@@ -687,9 +694,9 @@ def test_the_ambiguous_reason_says_which_rule_left_the_finding_undecided():
 
 
 def test_a_change_of_lift_puts_minus_delta_cz_tan_alpha_on_cx():
-    """analysis.lift_change_on_cx: a lift change ΔC_L rotated into body axes is
+    """term_rules.lift_change_on_cx: a lift change ΔC_L rotated into body axes is
     ΔC_X = ΔC_L sin α, ΔC_Z = −ΔC_L cos α."""
-    from harness.diagnosis.analysis import lift_change_on_cx
+    from harness.diagnosis.term_rules import lift_change_on_cx
     alpha = np.linspace(-0.1, 0.4, 11)
     d_cl = 0.6 * alpha + 0.01
     assert np.allclose(lift_change_on_cx(-d_cl * np.cos(alpha), alpha), d_cl * np.sin(alpha), atol=1e-15)
@@ -701,7 +708,7 @@ def _lift_case(extra_cx: float):
     of its own (a sinusoid the lift change does not follow)."""
     from types import SimpleNamespace
 
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.evidence import Candidate
     n, dt = 1500, 0.02
     t = np.arange(n) * dt
     alpha = 0.148 + 0.035 * np.sin(2 * np.pi * 0.3 * t) * np.sin(2 * np.pi * 0.05 * t)
@@ -726,18 +733,19 @@ def _lift_case(extra_cx: float):
 
 
 def test_a_cx_term_that_a_named_lift_change_explains_is_withheld():
-    """analysis._withhold_explained_by_lift: the C_X α³ column takes the lift change's C_X
+    """term_rules.withhold_explained_by_lift: the C_X α³ column takes the lift change's C_X
     share at |t| >= 5 (10.2 here, 5.5 on the probe), and falls under the entry t once that
     share is removed (4.6; the probe 3.4: the C_Z fit's straight line leaves cos α's
     curvature); a C_X term the lift change does not explain stays named."""
-    from harness.diagnosis.analysis import _inner, _withhold_explained_by_lift
+    from harness.diagnosis.along import interior
+    from harness.diagnosis.term_rules import withhold_explained_by_lift
     from estimators.colored_stepwise import colored_fit
     cands, selections, mismatch, p = _lift_case(0.002)
-    inner = _inner(p)
+    inner = interior(p)
     cols = [selections["CX"][1][k].column[inner] for k in ("own", "alpha3")]
     theta, se, _ = colored_fit(mismatch["CX"][inner], cols, ["own", "alpha3"])
     assert abs(theta[1] / se[1]) >= 5.0  # the lift change alone makes the α³ term significant
-    _withhold_explained_by_lift(cands, selections, mismatch, p)
+    withhold_explained_by_lift(cands, selections, mismatch, p)
     alpha3, own = cands[1], cands[2]
     assert not alpha3.selected and "change of lift" in alpha3.reason
     assert own.selected and own.reason == "entered"
@@ -750,8 +758,8 @@ def _drift_case(along_vane_size: float, monkeypatch):
     τ = 1 s, times −0.1/rad)."""
     from types import SimpleNamespace
 
-    from harness.diagnosis import analysis
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis import term_rules
+    from harness.diagnosis.evidence import Candidate
     n, dt = 1500, 0.02
     t = np.arange(n) * dt
     dv = 0.06 * np.sin(np.pi * t / t[-1]) ** 2
@@ -760,20 +768,20 @@ def _drift_case(along_vane_size: float, monkeypatch):
     for i in range(1, n):
         wander[i] = wander[i - 1] * np.exp(-dt / 1.0) + 0.00175 * np.sqrt(1 - np.exp(-2 * dt)) * rng.standard_normal()
     vane = along_vane_size * dv - 0.1 * wander + 2e-5 * rng.standard_normal(n)
-    monkeypatch.setattr(analysis, "inertial_beta", lambda p: True)
-    monkeypatch.setattr(analysis, "model_along", lambda *a, **k: SimpleNamespace(mismatch=lambda: {"Cl": vane}))
+    monkeypatch.setattr(term_rules, "inertial_beta", lambda p: True)
+    monkeypatch.setattr(term_rules, "model_along", lambda *a, **k: SimpleNamespace(mismatch=lambda: {"Cl": vane}))
     term = SimpleNamespace(parameter="Cl_dV", column=dv, scale=1.0)
     step = SimpleNamespace(selections={"Cl": (SimpleNamespace(names=("dV",), params={"dV": 0.004}), {"dV": term})},
                            nuisances={"Cl": {}})
     c = Candidate("flight_condition_drift", "roll", "Cl", "Cl_dV", 0.004, 0.0002, 20.0, 0.5, "per unit dV/V",
                   "stepwise on the Cl mismatch", True, "entered")
     p = SimpleNamespace(dt=dt, n=n)
-    analysis._withhold_lateral_drift_off_the_vane([c], step, p, None, None)
+    term_rules.withhold_lateral_drift_off_the_vane([c], step, p, None, None)
     return c
 
 
 def test_a_lateral_drift_term_the_beta_vane_does_not_show_is_withheld(monkeypatch):
-    """analysis._withhold_lateral_drift_off_the_vane: a C_l ΔV/V entered along the inertial
+    """term_rules.withhold_lateral_drift_off_the_vane: a C_l ΔV/V entered along the inertial
     sideslip is refitted on the mismatch along the β vane. Where the vane's mismatch carries
     it (0.004, under the vane's wander) it stays named; where it does not (the inertial
     sideslip's own drift made it), it is withheld with the vane's t in its reason."""
@@ -788,7 +796,7 @@ def test_a_validation_maneuver_that_does_not_excite_a_term_leaves_it_untested():
     α·β coupling is untested there while C_l,β is tested; on a stabilator-only maneuver (β, p,
     r not driven) a C_l,β or C_n α·β finding is tested as before (a maneuver of another kind;
     the noise it meets leaves the finding unconfirmed), and so is C_m,q̂."""
-    from harness.diagnosis.analysis import Candidate
+    from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.prepare import prepare
     from harness.diagnosis.run import untestable
 
@@ -812,8 +820,9 @@ def _alpha_power_case(linear: float, cubic: float, monkeypatch):
     (0.01°)."""
     from types import SimpleNamespace
 
-    from harness.diagnosis import analysis
-    from harness.diagnosis.analysis import INERTIAL_CHANNELS, Candidate
+    from harness.diagnosis import term_rules
+    from harness.diagnosis.along import INERTIAL_CHANNELS
+    from harness.diagnosis.evidence import Candidate
     n, dt = 1500, 0.02
     t = np.arange(n) * dt
     rng = np.random.default_rng(21)
@@ -821,20 +830,20 @@ def _alpha_power_case(linear: float, cubic: float, monkeypatch):
     alpha = 0.09 + da
     z = linear * da + cubic * da ** 3 + 5e-5 * rng.standard_normal(n)
     inertial = alpha + 0.00017 * rng.standard_normal(n)
-    monkeypatch.setattr(analysis, "clean_channels", lambda p, names: {})
-    monkeypatch.setattr(analysis, "inertial_angles", lambda ch, p: {"alpha": inertial})
+    monkeypatch.setattr(term_rules, "clean_channels", lambda p, names: {})
+    monkeypatch.setattr(term_rules, "inertial_angles", lambda ch, p: {"alpha": inertial})
     term = SimpleNamespace(parameter="Cm_alpha3", column=da ** 3, scale=1.0)
     step = SimpleNamespace(selections={"Cm": (SimpleNamespace(names=("alpha3",), params={}), {"alpha3": term})},
                            nuisances={"Cm": {}})
     c = Candidate("nonlinear_alpha", "pitch", "Cm", "Cm_alpha3", -800.0, 40.0, -9.8, 0.5, "per rad^3",
                   "stepwise on the Cm mismatch", True, "entered")
     p = SimpleNamespace(dt=dt, n=n, smooth={k: alpha for k in INERTIAL_CHANNELS}, start={"alpha": 0.09})
-    analysis._withhold_alpha_power_off_the_inertial_alpha([c], step, p, {"Cm": z})
+    term_rules.withhold_alpha_power_off_the_inertial_alpha([c], step, p, {"Cm": z})
     return c
 
 
 def test_an_alpha_power_the_inertial_alpha_calls_linear_is_withheld(monkeypatch):
-    """analysis._withhold_alpha_power_off_the_inertial_alpha: a C_m α³ named where the
+    """term_rules.withhold_alpha_power_off_the_inertial_alpha: a C_m α³ named where the
     mismatch is linear in α (a C_m,α change of −0.3) is withheld once both shapes are fitted
     along the inertial α; a mismatch that is cubic (−800 per rad³, as large over the
     maneuver) keeps it."""

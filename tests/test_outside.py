@@ -361,7 +361,7 @@ def test_vanes_wandering_as_far_as_gusts_are_not_turbulence(tmp_path):
 def test_a_c172x_alpha_vane_bias_is_named_from_the_longitudinal_coefficient_means(tmp_path):
     """Outside case C1_pitch (1° α-vane bias, c172x at 180 ft/s): the kinematics hardly see
     it (t 1.4); the means of C_X, C_Z and C_m along the vane are off by the model's own slopes
-    times one constant (analysis._name_vane_bias_from_means, offered for α as for β), and
+    times one constant (sensor_naming.name_vane_bias_from_means, offered for α as for β), and
     the validation maneuver shows it too. Size within 2 standard errors or 5 %."""
     import math
 
@@ -379,7 +379,7 @@ def test_a_c172x_alpha_vane_bias_is_named_from_the_longitudinal_coefficient_mean
 def test_a_c172x_moment_drift_is_named_once_the_vane_noise_leaves_cm(tmp_path):
     """Outside case C1_three_axis (C_m ΔV/V 0.02, c172x at 180 ft/s): the α vane's wander,
     passed through the model's C_m,α, was a third of C_m's mismatch and hid the drift; with
-    the vane-noise column in C_m's fit (analysis._vane_noise_columns) it is named, its size
+    the vane-noise column in C_m's fit (stepwise_axes.vane_noise_columns) it is named, its size
     within 25 %, nothing else named."""
     from harness.diagnosis.outside import cases, run_case
     c = next(c for c in cases() if c.name == "C1_three_axis_flight_condition_drift_Cm_dV_0.02")
@@ -391,7 +391,7 @@ def test_a_c172x_moment_reference_shift_is_sized_by_the_mistrim_of_cm(tmp_path):
     """Outside case C2_three_axis (0.25 ft moment-reference shift, c172x at 200 ft/s): the
     stepwise entered the shift at about 1 ft beside a C_m,α that shared its C_Z column;
     C_m's constant, the mistrim Δx·mean(C_Z)/c̄ a shift makes, refutes that size and names
-    the one it says (analysis._cg_mean_test): within 2 standard errors or 25 % of 0.25 ft,
+    the one it says (stepwise_axes._cg_mean_test): within 2 standard errors or 25 % of 0.25 ft,
     nothing else named, the validation's q fit better by 30 % or more."""
     from harness.diagnosis.outside import cases, run_case
     c = next(c for c in cases() if c.name == "C2_three_axis_cg_offset_dx_moment_reference_0.25")
@@ -407,8 +407,8 @@ def test_an_alpha_scale_at_the_flap_switch_is_named_alone(tmp_path):
     condition; seed 2106, not a sweep case): the coefficient means name the scale's offset
     at trim α (0.47° at 5.03°) as a bias and the force mismatch along the scaled α asks for
     an accelerometer 6.9 ft forward. The bias is read as the scale's offset
-    (analysis._scale_read_as_bias) and the position, fitted again along the corrected α,
-    vanishes (analysis._withhold_offset_of_a_scaled_vane): the scale alone, its size within
+    (sensor_rules.scale_read_as_bias) and the position, fitted again along the corrected α,
+    vanishes (sensor_rules.withhold_offset_of_a_scaled_vane): the scale alone, its size within
     2 standard errors or 25 %."""
     from dataclasses import replace
 

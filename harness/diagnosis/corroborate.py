@@ -3,7 +3,7 @@
 The kinematic check names a sensor error on its own only at |t| >= its entry t
 (:data:`harness.diagnosis.kinematics.T_IN`, 6). Below that, a scale, lag or vane error it
 merely *suspects* already keeps the coefficient terms it would imitate from being named
-(``analysis._withhold_ambiguous``, the vane-bias rival of :mod:`rivals`). The coefficient
+(``term_rules.withhold_ambiguous``, the vane-bias rival of :mod:`rivals`). The coefficient
 mismatch is then a second, independent test of the same instrument error: the model's
 aerodynamics are evaluated along the recorded states (seed Eqs. 1-5), so a sensor error
 leaves a definite signature on *every* axis.

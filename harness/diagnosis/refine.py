@@ -103,7 +103,7 @@ def refined_terms(added: tuple[HiddenEffect, ...], sizes: dict[str, float]) -> t
 
 
 def refined_finding(f, size: float):
-    """A copy of finding ``f`` (:class:`~harness.diagnosis.analysis.Candidate`) at the
+    """A copy of finding ``f`` (:class:`~harness.diagnosis.evidence.Candidate`) at the
     calibrated term size: a coefficient error's estimate is its model value plus the new
     change; the other terms' estimate is the size itself."""
     if f.effect == "coefficient_error":

@@ -16,9 +16,13 @@ from scipy import signal
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
-from harness.diagnosis.analysis import MEANS_TESTS, Analysis, Candidate, analyse, name_replicated, vane_wander
+from harness.diagnosis.along import interior
+from harness.diagnosis.analysis import analyse
+from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.fits import coefficient_fit, output_fit
+from harness.diagnosis.gust_rules import vane_wander
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare, undriven_reason, instruments_at_cg
+from harness.diagnosis.sensor_naming import MEANS_TESTS, name_replicated
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
 from harness.executors import LocalPool
 from harness.recording_io import read_recording
@@ -137,7 +141,7 @@ def _terms_of(findings: list[Candidate], applied: dict[str, float]) -> tuple[Hid
         out.append(e)
         bias = f"bias_{e.channel}"
         if e.effect == "sensor_scale" and bias in applied and not any(g.parameter == bias for g in findings) \
-                and "offset" not in f.details:  # a scale read from the bias carries it (analysis._scale_read_as_bias)
+                and "offset" not in f.details:  # a scale read from the bias carries it (sensor_rules.scale_read_as_bias)
             out.append(HiddenEffect("sensor_bias", float(applied[bias]), channel=e.channel))
     return tuple(out)
 
@@ -191,11 +195,6 @@ def _after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, n
     return after, n_terms
 
 
-def _inner(p: Prepared) -> slice:
-    k = max(1, int(round(1.0 / p.dt)))
-    return slice(k, p.n - k)
-
-
 def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean((x - x.mean()) ** 2)))
 
@@ -218,7 +217,7 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     why = untestable(av.prepared, f)
     if why:
         return {"status": "untested", "axes": axes, "reason": why}
-    inner = _inner(av.prepared)
+    inner = interior(av.prepared)
     before_rms = {c: _rms(av.mismatch[c][inner]) for c in axes}
     after_rms = {c: _rms(after[c][inner]) for c in axes}
     w = _noise_weights(av, axes)
@@ -333,7 +332,7 @@ def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, n
     twin = Candidate(r["effect"], f.axis, r["axis"], r["parameter"], 0.0, 0.0, r["t_rival"], 0.0, "", f.test,
                      details={"change": r["coefficient"]})
     rival_after, _ = _after_mismatch(av, [twin])
-    inner = _inner(av.prepared)
+    inner = interior(av.prepared)
     rival_rms = {c: _rms(rival_after[c][inner]) for c in axes}
     # summed over the axes in units of each axis's noise level, as validation_check does
     w = _noise_weights(av, axes)
@@ -371,7 +370,7 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
     if "replication" in f.details:  # named on the two maneuvers' kinematics together
         v, sv = f.details["replication"]["validation"]
         return {"status": "confirmed", "axes": [], "estimate": float(v), "std_error": float(sv), "t": float(v / sv),
-                "rule": "named on both maneuvers' kinematics (analysis.name_replicated)"}
+                "rule": "named on both maneuvers' kinematics (sensor_naming.name_replicated)"}
     twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
     if twin is None:
         return {"status": "neutral", "axes": [], "estimate": None, "t": None,
@@ -397,7 +396,7 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
 
 def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | None:
     """A scale factor named on its offset and its excursions together
-    (:func:`analysis._scale_read_as_bias`), tested the same way on the validation maneuver:
+    (:func:`sensor_rules.scale_read_as_bias`), tested the same way on the validation maneuver:
     there too the offset at the mean (its bias read as k = b/x̄_true) and the excursions
     (the kinematic k, ``twin``) must agree within two standard errors; their
     inverse-variance mean is then the validation maneuver's estimate, judged as any sensor
@@ -422,7 +421,7 @@ def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | N
 
 
 def _vane_means_check(av: Analysis, f: Candidate) -> dict:
-    """A vane bias named on the coefficient means (:func:`analysis._name_vane_bias_from_means`),
+    """A vane bias named on the coefficient means (:func:`sensor_naming.name_vane_bias_from_means`),
     tested the same way on the validation maneuver: the same vane, so the same sign at
     |t| >= :data:`SENSOR_CONFIRM_T` there ('confirmed'), the opposite sign at that |t|
     ('contradicted'), else 'neutral'. Where the validation maneuver's kinematics gave the bias
@@ -494,7 +493,7 @@ def _fitted_replay(p: Prepared, fly) -> Replayed:
     bounds = {s: levels.level_bound(p.smooth[s], p.noise_std.get(s, 0.0), p.t) for s in surfaces}
     floors = {c: max(p.noise_std.get(c, 0.0), 1e-9) for c in OUTPUTS if c in p.smooth}
     try:
-        fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, _inner(p))
+        fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, interior(p))
     except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
         return Replayed(None, {}, str(exc))
     return Replayed(fit.outputs, fit.offsets)
@@ -531,7 +530,7 @@ def _maneuver(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
     a = analysis
     before_mm = a.mismatch
     after_mm, n_terms = _after_mismatch(a, findings or [])
-    inner = _inner(p)
+    inner = interior(p)
     nan = {c: np.full(p.n, np.nan) for c in _CHANNEL_COLUMNS}
     sim_b = before.outputs if before.outputs is not None else nan
     sim_a = after.outputs if after.outputs is not None else nan
@@ -608,7 +607,7 @@ def structured_part(p: Prepared, mismatch: np.ndarray) -> np.ndarray:
     reg = cand.regressors(p)
     cols = [reg[k] for k in sorted(reg) if np.ptp(reg[k]) > 0]
     cols.append(p.deriv["alpha"] * p.meta["geometry"]["cbar_ft"] / (2.0 * p.smooth["V"]))
-    inner = _inner(p)
+    inner = interior(p)
     A = np.column_stack([c[inner] for c in cols] + [np.ones(inner.stop - inner.start)])
     theta, *_ = np.linalg.lstsq(A, mismatch[inner], rcond=None)
     fitted = A @ theta
@@ -650,7 +649,7 @@ def _located(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> d
     worst_out = max(ranked_outs, key=lambda c: outs[c]["ratio"]) if ranked_outs else None
     axis = focus if focus in coefs else worst_axis
     r = np.zeros(p.n)
-    r[_inner(p)] = structured_part(p, a.mismatch[axis])
+    r[interior(p)] = structured_part(p, a.mismatch[axis])
     # when: the 2 s window with the largest mismatch energy; where: the band holding most power
     w = max(1, int(round(2.0 / p.dt)))
     energy = np.convolve(r ** 2, np.ones(w), mode="valid")
@@ -713,7 +712,7 @@ def _offset_direction(parameter: str, estimate: float) -> tuple[str, str]:
     return axis, ahead if estimate >= 0 else behind
 
 
-# A vane bias named on the coefficient means (analysis._name_vane_bias_from_means).
+# A vane bias named on the coefficient means (sensor_naming.name_vane_bias_from_means).
 EXPLAIN_VANE_MEANS = ("The {channel} vane reads {estimate:.4g} ± {std_error:.2g} {units} off: the model evaluated "
                       "along it is off by its own slopes in that angle times one constant on every axis it reaches.")
 
@@ -738,7 +737,7 @@ def _finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None =
         text = template.format(**fmt)
     except (KeyError, ValueError):
         text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
-    if c.details.get("not_ruled_out"):  # an assumption the result rests on (analysis._withhold_skewed_delay)
+    if c.details.get("not_ruled_out"):  # an assumption the result rests on (term_rules._withhold_skewed_delay)
         text += f" Caveat: {c.details['not_ruled_out']}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})

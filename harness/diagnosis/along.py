@@ -1,0 +1,133 @@
+"""The model evaluated along a recording's states (seed Eqs. 1-5 on both sides): which states
+it follows (the inertial sideslip, undriven states held), the measured coefficients beside
+its own, the maneuver's interior, a recording corrected for sensor values, and the model's
+local slopes along the states."""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import NamedTuple
+
+import numpy as np
+
+from harness.diagnosis import rivals
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, measured_coefficients
+from models.aircraft import Aircraft
+from models.constants import SURFACES
+from models.replay import AeroAlong, InitialCondition, aero_along
+
+
+def corrected_recording(p: Prepared, kin: KinematicResult, values: dict[str, float]) -> Prepared:
+    """The recording with its channels corrected for the sensor ``values`` (re-smoothed and
+    re-differentiated); ``p`` itself when there are none."""
+    if not values:
+        return p
+    ch = corrected_channels(p.raw, p, kin.parameters, values)
+    smooth = {c: p.filt(x) for c, x in ch.items()}
+    deriv = {c: p.differentiate(x) for c, x in ch.items()}
+    k = max(1, int(round(0.5 / p.dt)))
+    start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
+    return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
+
+
+def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: bool = False,
+                 vanes: bool = False) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The states and surfaces the model is evaluated along.
+
+    A state the maneuver did not drive is held at its start: evaluated along its noise, the
+    model would pass that noise on through its derivative (errors in variables), and the
+    mismatch would then show the derivative itself as "wrong" (unless it drifted far from its
+    start all the same, :attr:`Prepared.moved`: then holding it would be the larger error).
+    Surfaces are measured with
+    little noise: always as recorded (holding one that moves, say by a feedback loop, would
+    be far worse than its noise). Airspeed and altitude are slow: their own optimal
+    smoothing (a far lower cut-off than the common filter's) keeps their noise out of the
+    model's coefficients (through q̂ = qc̄/2V, dynamic pressure and Mach-scheduled terms).
+
+    A driven sideslip is the inertial one (:func:`kinematics.inertial_angles`: the v̇ equation
+    integrated from a_y, the rates and attitude, placed on the vane by a constant and trend):
+    a vane's slow wander survives any smoother and reaches the mismatch through C_n,β, C_l,β
+    and C_Y,β, where it buried the outside sweep's lateral coefficient errors (C_l,β −0.02,
+    C_n,β +0.03, C_n,r̂ −0.3, C_l,p̂ −0.1 at |t| 1.6–4.7; 5.9–22 along the inertial β). A β-vane
+    scale then leaves the mismatch alone; the kinematic check names it. With ``vane_beta``
+    the sideslip is the vane's; with ``vanes`` α and β are both the vanes' own smoothed
+    records, driven or not (the vane-bias tests on the coefficient means)."""
+    states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
+    for k in ("alpha", "beta", "p", "q", "r"):
+        if k in states and k not in p.driven and k not in p.moved and not (vanes and k in ("alpha", "beta")):
+            states[k] = np.full(p.n, p.start[k])
+    if inertial_beta(p) and not (vane_beta or vanes):
+        src = inertial_from or p
+        states["beta"] = inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)["beta"]
+    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
+    if "V" in p.own_noise:
+        states["V"] = p.raw["V"] - p.own_noise["V"]
+    if p.altitude is not None:
+        states["h"] = p.altitude
+    return states, surfaces
+
+
+class ModelAlong(NamedTuple):
+    """The model evaluated along a recording's states (seed Eqs. 1-5 on both sides)."""
+
+    states: dict[str, np.ndarray]
+    surfaces: dict[str, np.ndarray]
+    alphadot: np.ndarray | None
+    aero: AeroAlong
+    measured: dict[str, np.ndarray]
+
+    def mismatch(self) -> dict[str, np.ndarray]:
+        return {c: self.measured[c] - self.aero.coefficients[c] for c in COEFFICIENTS}
+
+
+def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
+                inertial_from: Prepared | None = None, vane_beta: bool = False, vanes: bool = False) -> ModelAlong:
+    """The measured coefficients and the model's along the states of :func:`model_states`
+    (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
+    sideslip with ``vane_beta``; both vanes' own records with ``vanes``)."""
+    states, surfaces = model_states(p, inertial_from, vane_beta, vanes)
+    alphadot = cand.alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
+    aero = aero_along(aircraft, ic, states, surfaces, alphadot)
+    measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
+    return ModelAlong(states, surfaces, alphadot, aero, measured)
+
+
+# What the inertial sideslip is integrated from (kinematics.inertial_angles).
+INERTIAL_CHANNELS = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ay", "az")
+
+
+def inertial_beta(p: Prepared) -> bool:
+    """Whether the model is evaluated along the inertial sideslip (:func:`model_states`)."""
+    return "beta" in p.driven and all(c in p.raw for c in INERTIAL_CHANNELS)
+
+
+def interior(p: Prepared) -> slice:
+    """The maneuver's interior: the first and last second are where the smoother is least
+    accurate."""
+    k = max(1, int(round(1.0 / p.dt)))
+    return slice(k, p.n - k)
+
+
+def slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],
+                    surfaces: dict[str, np.ndarray], alphadot: np.ndarray | None, aero: AeroAlong):
+    """``slope_of(x)``: the model's ∂C/∂x along the states (:mod:`rivals`), evaluated on first
+    use and kept."""
+    slopes: dict[str, dict[str, np.ndarray]] = {}
+
+    def slope_of(x: str) -> dict[str, np.ndarray]:
+        if x not in slopes:
+            shifted = dict(states)
+            shifted[x] = np.asarray(states[x], dtype=float) + rivals.SLOPE_STEP_RAD
+            moved = aero_along(aircraft, ic, shifted, surfaces, alphadot)
+            slopes[x] = {c: (moved.coefficients[c] - aero.coefficients[c]) / rivals.SLOPE_STEP_RAD
+                         for c in COEFFICIENTS}
+        return slopes[x]
+    return slope_of
+
+
+def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
+    """Thrust for Eqs. 1 and 4 when the recording has no thrust channel: constant at trim
+    (recording-format.md), the metadata's trim thrust when given, else the model's."""
+    given = (p.meta.get("trim") or {}).get("thrust_lbf")
+    return float(given) if given is not None else float(model_trim_thrust_lbf)

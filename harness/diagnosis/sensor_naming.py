@@ -1,0 +1,369 @@
+"""Sensor errors named on two independent tests: the coefficient signatures along the vanes
+(a vane scale or bias), the coefficient means, kinematic rivals, values applied before the
+model was evaluated, and findings replicated on both maneuvers."""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
+from harness.diagnosis import corroborate
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along
+from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+from harness.diagnosis.prepare import Prepared
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_estimate, kinematic_rival, kinematic_share,
+                                            kinematic_t, kinematics_plausible, kinematics_refute, sensor_verdict)
+from harness.diagnosis.stepwise_axes import StepwiseFits
+from models.aircraft import Aircraft
+from models.hidden import SENSOR_EFFECTS
+from models.replay import InitialCondition
+
+
+def signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                      ic: InitialCondition, mismatch: dict[str, np.ndarray], step: StepwiseFits):
+    """``ratios(name, value, skip)``: per axis, the multiple of the mismatch change that
+    correcting the channels by sensor parameter ``name`` = ``value`` makes (the model evaluated
+    again along the corrected channels, :mod:`corroborate`), fitted beside the axis's named
+    terms whose parameter is not in ``skip`` (and its nuisances)."""
+    inner = interior(p)
+
+    @functools.cache
+    def along_vane() -> dict[str, np.ndarray]:
+        """The mismatch along the β vane (made when first asked)."""
+        return model_along(p, aircraft, ic, vane_beta=True).mismatch()
+
+    def ratios(name: str, value: float, skip: frozenset[str] = frozenset(), constant: bool = True) -> dict:
+        # the inertial sideslip stays the one integrated from p: it is built from the same
+        # instruments as the kinematic check, so letting it follow the correction would make
+        # the two tests one
+        if kin.parameters[name].channel == "beta" and inertial_beta(p):
+            # a β-vane error cannot reach a mismatch along the inertial sideslip: its signature
+            # is taken along the vane (whose slow wander the colored-residual fit allows for)
+            changed = model_along(corrected_recording(p, kin, {name: value}), aircraft, ic, vane_beta=True).mismatch()
+            return _axis_ratios(cands, step, inner, along_vane(), changed, skip, constant)
+        changed = model_along(corrected_recording(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
+        return _axis_ratios(cands, step, inner, mismatch, changed, skip, constant)
+    return ratios
+
+
+def _axis_ratios(cands: list[Candidate], step: StepwiseFits, inner: slice, base: dict[str, np.ndarray],
+                 changed: dict[str, np.ndarray], skip: frozenset[str] = frozenset(), constant: bool = True) -> dict:
+    """Per axis, :func:`corroborate.axis_ratio` of ``base`` on the change ``changed - base``,
+    beside the axis's named terms (those in ``skip`` left out) and its nuisance columns (with
+    a constant unless not ``constant``)."""
+    out = {}
+    for axis, (sel, by_key) in step.selections.items():
+        kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
+        others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
+        r = corroborate.axis_ratio(base[axis][inner], others, (changed[axis] - base[axis])[inner], constant)
+        if r is not None:
+            out[axis] = r
+    return out
+
+
+# The vane scale factor at which its signature is evaluated (the fit scales it).
+PROBE_SCALE = 0.05
+
+
+def withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: StepwiseFits, signature,
+                         inertial: bool = False) -> None:
+    """Deselect coefficient errors on α or β that a scale error of that vane would imitate on
+    every axis that can tell (:func:`corroborate.imitates`): the model evaluated along a
+    scaled angle is off by each coefficient's own slope times the scaled excursion, so a
+    vane scale looks like C_Z,α, C_m,α and C_X,α wrong in the model's own proportions, which
+    no single coefficient error does. The kinematics cannot always see the scale (its
+    column is nearly a bias's when the angle hardly moves about its mean). Not for β when the
+    model follows the inertial sideslip (``inertial``): a vane scale cannot reach the mismatch
+    then. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing."""
+    for x in ("alpha",) + (() if inertial else ("beta",)):
+        name = f"scale_{x}"
+        chosen = [c for c in cands if c.selected and c.effect == "coefficient_error"
+                  and cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1]) == x]
+        if not chosen or name not in kin.parameters:
+            continue
+        same = frozenset(c.parameter for c in cands if c.parameter.endswith(f"_{x}") and c.test.startswith("stepwise"))
+        ag = corroborate.imitates(signature(name, PROBE_SCALE, same), t_aero=cand.T_IN)
+        if ag is None or not is_plausible(name, ag.ratio * PROBE_SCALE, 1.0):
+            continue
+        refuted = kinematics_refute(kin, name, ag.ratio * PROBE_SCALE, ag.std_error * PROBE_SCALE)
+        if refuted:
+            for c in chosen:
+                c.details["vane_scale_refuted"] = refuted
+            continue
+        for c in chosen:
+            c.selected = False
+            c.details["sensor_rival"] = name
+            each = ", ".join(f"{a.axis} {a.ratio * PROBE_SCALE:.3f} ± {a.std_error * PROBE_SCALE:.3f}"
+                             for a in ag.axes)
+            c.reason = (f"entered, but not named: an {x} vane scale error of k = {ag.ratio * PROBE_SCALE:.3f} would "
+                        f"explain the mismatch on every axis that can tell alike (k from {each}), in the model's own "
+                        "proportions, which a wrong derivative on one axis does not")
+
+
+# The vane bias (rad) at which its signature on the coefficient means is evaluated (the fit
+# scales it).
+PROBE_VANE_BIAS = np.radians(0.5)
+# Per vane: the axes its bias reaches through the model's slopes, and the test's name. For α
+# the force axes' means also carry errors of the thrust's direction and level and of the mass,
+# which an α bias's C_X and C_Z proportions can match: offered for α earlier, the test named
+# an α bias of −1.87° on the 737's noise-free self-check from C_X and C_Z alone (its engines'
+# thrust is not along body x). Offered again after the later rules (the vane's wander and the
+# light-gust tests, the sensor-suspicion imitation size), it named the c172x's 1° α bias at
+# 180 ft/s (1.036 ± 0.018°, on C_X, C_Z and C_m; the kinematics t 1.4), changed no other
+# case, and left all 70 nulls and self-checks of the outside sweep and 11 of the project's
+# `none` (the 737's self-check included). On 82 null and self-check recordings the β test
+# agreed on no bias above 0.066° (practical: 0.15°).
+VANE_MEANS_AXES = {"beta": cand.LAT, "alpha": cand.LON}
+MEANS_TESTS = {"beta": "lateral coefficient means along the β vane",
+               "alpha": "longitudinal coefficient means along the α vane"}
+
+
+def birge_scaled(ag: corroborate.Agreement) -> float:
+    """The common ratio's standard error, scaled by the Birge ratio √(χ²/(k − 1)) of the axes'
+    scatter about it when that exceeds 1: the colored-residual errors of a constant are
+    small, and the axes then disagree by more than they allow because the model's own slopes
+    carry errors too (R. T. Birge, Phys. Rev. 40, 207 (1932), the calculation of errors by
+    the method of least squares)."""
+    k = len(ag.axes)
+    if k < 2:
+        return ag.std_error
+    chi2 = sum(((a.ratio - ag.ratio) / a.std_error) ** 2 for a in ag.axes)
+    return ag.std_error * max(1.0, float(np.sqrt(chi2 / (k - 1))))
+
+
+def name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                               ic: InitialCondition, step: StepwiseFits, channel: str, applied: float = 0.0) -> None:
+    """Name a vane bias (``channel``; :data:`VANE_MEANS_AXES`) from the coefficients' means
+    along the vane.
+
+    The kinematics can all but miss a vane bias (β enters them through cos β: a 1° bias stood
+    at t 1.3-1.5; a c172x's 1° α bias at 180 ft/s at t 1.4), and the stepwise fits' constants
+    absorb what it does to the coefficients. But the model evaluated along a vane that reads
+    x + b is off by each coefficient's own slope in x times b: one constant on C_Y, C_l and
+    C_n (β) or C_X, C_Z and C_m (α) in the model's proportions. So each such axis's mismatch
+    is fitted on the change a probe bias makes (:data:`PROBE_VANE_BIAS`), without a constant
+    (beside the axis's named terms and nuisances), along the vanes' own records whether or not
+    the maneuver moved them (held at a start sample, the test would measure that sample's
+    noise); a kinematic estimate already applied to the channels (``applied``) is added
+    back. The bias is named when the axes that can tell agree on it, significantly
+    (:func:`corroborate.imitates`), and it is practical and precise (:func:`sensor_verdict`).
+    A constant model error on one axis (an asymmetry, a propeller's torque, a thrust or mass
+    error, a moment-reference shift) does not match the slopes' proportions on all of them.
+    The estimate is kept in ``details['vane_means']`` whether named or not, for the
+    validation maneuver's check."""
+    name = f"bias_{channel}"
+    c = next((c for c in cands if c.parameter == name), None)
+    if c is None or c.selected or name not in kin.parameters:
+        return
+    base = model_along(p, aircraft, ic, vanes=True).mismatch()
+    changed = model_along(corrected_recording(p, kin, {name: PROBE_VANE_BIAS}), aircraft, ic, vanes=True).mismatch()
+    ratios = {k: r for k, r in _axis_ratios(cands, step, interior(p), base, changed, constant=False).items()
+              if k in VANE_MEANS_AXES[channel]}
+    ag = corroborate.imitates(ratios, t_aero=cand.T_IN)
+    if ag is None:
+        return
+    # the channels were corrected by the kinematic estimate already applied: the means see the rest
+    est, se = applied + ag.ratio * PROBE_VANE_BIAS, birge_scaled(ag) * PROBE_VANE_BIAS
+    c.details["vane_means"] = {"estimate": est, "std_error": se, "applied_before": applied,
+                               "axes": {a.axis: [a.ratio * PROBE_VANE_BIAS, a.std_error * PROBE_VANE_BIAS]
+                                        for a in ag.axes}}
+    # named only when the means alone, their scatter allowed for, stand at the entry t
+    if abs(est - applied) < cand.T_IN * se or not sensor_verdict(name, est, se, True, kin, p, False, True)[0]:
+        return
+    each = ", ".join(f"{a.axis} {np.degrees(a.ratio * PROBE_VANE_BIAS):.2f}° ± "
+                     f"{np.degrees(a.std_error * PROBE_VANE_BIAS):.2f}°" for a in ag.axes)
+    c.reason = (f"the model along the {'α' if channel == 'alpha' else 'β'} vane is off by its own slopes times one "
+                f"constant on every axis that can tell ({each}); the kinematics alone: t = {c.t:.1f}")
+    c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
+    c.test = MEANS_TESTS[channel]
+
+
+def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature, applied: set[str],
+                       V0: float) -> None:
+    """Name a suspected sensor error (kinematic |t| >= :data:`AMBIGUOUS_T`, below the kinematic
+    entry t), whether or not it kept a coefficient term from being named, when the coefficient
+    mismatch independently shows the same error on every axis that can tell
+    (:mod:`corroborate`). Its signature is the change in the mismatch when the channels are
+    corrected by the kinematic estimate and the model is evaluated again. (Offered only to the
+    suspects that had withheld a term, a 40 ms p-gyro skew at 700 ft/s, t = 3.7, and a 6 ft
+    lateral accelerometer offset, t = 5.1, went unnamed; on the outside and project sweeps the
+    wider offer named no wrong error.)"""
+    suspects = sorted({c.details["sensor_rival"] for c in cands if not c.selected and "sensor_rival" in c.details}
+                      | {c.parameter for c in cands if c.effect in SENSOR_EFFECTS and not c.selected
+                         and c.reason == "below the entry t"})
+    for name in suspects:
+        sensor = next((c for c in cands if c.parameter == name), None)
+        found = kinematic_estimate(kin, name)
+        if sensor is None or sensor.selected or found is None or name in applied:
+            continue
+        v, t = found
+        if t < AMBIGUOUS_T or not is_plausible(name, v, V0):
+            continue
+        verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
+        if not _name_if_corroborated(sensor, kin, p, verdict, t):
+            continue
+        for c in cands:
+            if c.details.get("sensor_rival") == name:
+                c.reason += f"; explained by the {name} named"
+
+
+def kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature,
+                      contested: dict[str, tuple[str, float, float]]) -> None:
+    """A sensor error the kinematics name is kept only when they tell it from its most
+    collinear rival (|t| >= their entry t beside it): on a pitch maneuver an α scale factor
+    and an a_z skew both follow α̇ in the ẇ equation. When they cannot, the coefficient
+    mismatch decides (:mod:`corroborate`: each rival's computed signature, at its own
+    kinematic size, against every axis): the one it corroborates and the other not is named;
+    otherwise neither is."""
+    by_name = {c.parameter: c for c in cands}
+    for c in [c for c in cands if c.selected and c.parameter in contested]:
+        rival, r, t_beside = contested[c.parameter]
+        other = by_name.get(rival)
+        solo = kinematic_estimate(kin, rival)
+        verdicts = {}
+        for name, (v, t) in ((c.parameter, (c.estimate, abs(c.t))), (rival, solo or (0.0, 0.0))):
+            if v == 0.0 or t <= 0:
+                verdicts[name] = None
+                continue
+            verdicts[name] = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
+        own, theirs = verdicts[c.parameter], verdicts[rival]
+        c.details["kinematic_rival"] = {"parameter": rival, "correlation": r, "t_beside": t_beside,
+                                        "own": own.as_dict() if own else None,
+                                        "rival": theirs.as_dict() if theirs else None}
+        if own is not None and own.named and not (theirs is not None and theirs.named):
+            c.reason += (f"; the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = {t_beside:.1f}), "
+                         "but the coefficient mismatch shows this one, not that")
+            continue
+        c.selected = False
+        if theirs is not None and theirs.named and not (own is not None and own.named) and other is not None:
+            c.reason = (f"not named: the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = "
+                        f"{t_beside:.1f}), and the coefficient mismatch shows {rival}, not this")
+            _name_if_corroborated(other, kin, p, theirs, solo[1])
+            other.reason = theirs.reason + (f" (kinematic t = {solo[1]:.1f}; the kinematics alone cannot tell it "
+                                            f"from {c.parameter})")
+        else:
+            c.reason = (f"not named: the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = "
+                        f"{t_beside:.1f}), nor can the coefficient mismatch")
+        _withhold_absorbed_biases(cands, kin, c.parameter, rival)
+
+
+def _withhold_absorbed_biases(cands: list[Candidate], kin: KinematicResult, dropped: str, rival: str) -> None:
+    """With the kinematic fit redone on ``rival`` in place of ``dropped`` (the two it cannot tell
+    apart), a named bias whose |t| falls below the entry t is part of the rival's error (an α
+    scale factor shifts α's mean by k·ᾱ, which a bias otherwise takes) and is not named."""
+    cols = kin.columns or {}
+    names = [n for n in kin.forced + kin.selection.names if n != dropped and n in cols] + [rival]
+    try:
+        theta, se, _ = colored_fit(kin.start, [cols[n] for n in names], names, constant=False)
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return
+    t_alt = {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
+    for c in cands:
+        if c.selected and c.parameter in kin.forced and t_alt.get(c.parameter, np.inf) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"not named: with {rival} in place of {dropped} (the kinematics cannot tell them apart) it "
+                        f"falls to t = {t_alt[c.parameter]:.1f}: it may be part of {rival}")
+
+
+def name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepared, p: Prepared,
+                  aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
+                  removed: dict[str, np.ndarray], step: StepwiseFits, applied: dict[str, float], V0: float) -> None:
+    """Name a sensor error that was applied to the channels (|t| >= :data:`APPLY_T`) but is
+    below its entry t, when the coefficient mismatch corroborates it (:mod:`corroborate`):
+    here the mismatch *without* the correction is fitted on the change the correction made
+    (a 1.5 deg α bias that the correction took out of a C_m,α-like mismatch at t = 18)."""
+    inner = interior(p)
+    for name, v in applied.items():
+        sensor = next((c for c in cands if c.parameter == name), None)
+        if sensor is None or sensor.selected or sensor.reason != "below the entry t":
+            continue
+        without = corrected_recording(recorded, kin, {k: x for k, x in applied.items() if k != name})
+        base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic, inertial_from=p).mismatch().items()}
+        ratios = _axis_ratios(cands, step, inner, base, mismatch)
+        _name_if_corroborated(sensor, kin, p, corroborate.corroborate(name, v, abs(v) / kinematic_t(kin, name), ratios,
+                                                                      t_aero=cand.T_IN), kinematic_t(kin, name))
+
+
+def _name_if_corroborated(sensor: Candidate, kin: KinematicResult, p: Prepared, verdict, t_kin: float) -> bool:
+    """Select ``sensor`` at the verdict's combined size when the verdict names it and the size
+    is practical; the verdict is kept in ``details['corroboration']`` either way."""
+    sensor.details["corroboration"] = verdict.as_dict()
+    practical = (is_practical(sensor.parameter, verdict.estimate, p.dt)
+                 and kinematic_share(kin, sensor.parameter, verdict.estimate, p) >= cand.PRACTICAL_SHARE)
+    if not (verdict.named and practical):
+        return False
+    sensor.selected = True
+    sensor.estimate, sensor.std_error = verdict.estimate, verdict.std_error
+    sensor.t = verdict.estimate / verdict.std_error
+    sensor.reason = verdict.reason + f" (kinematic t = {t_kin:.1f}, below their entry t alone)"
+    return True
+
+
+# The |t| each maneuver's kinematic estimate must reach on its own for a sensor error below
+# the identification's entry t to be named on the two together (:func:`name_replicated`):
+# the suspicion level of the other sensor rules (:data:`AMBIGUOUS_T`).
+REPLICATED_EACH_T = AMBIGUOUS_T
+
+
+def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
+    """Name the sensor biases that the identification's kinematics only suspect (|t| at least
+    :data:`REPLICATED_EACH_T`, below the entry t) and the validation's show too (|t| at least
+    as much, the same sign, sizes within two standard errors), when their inverse-variance
+    combination reaches the kinematic entry t (:data:`kinematics.T_IN`): the same instrument
+    flew both, and their kinematic residuals carry independent noise. Not when either record's
+    kinematics are void (turbulence, light gusts, implausible estimates), when the
+    identification's kinematics cannot tell the parameter from a rival
+    (:func:`kinematic_rival`), or when the combined size is not practical and precise
+    (:func:`sensor_verdict`). Returns the candidates of ``a`` it selected.
+
+    Biases only, and only when no other sensor error is named: the replication shows the two
+    records' noise to be independent, not their systematic errors. A real error the kinematic
+    fit leaves out repeats in both records and pushes the columns that follow the same motion
+    alike: beside a β-vane scale of 0.15 (named on the coefficient mismatch, not in the
+    kinematic fit) both maneuvers asked for an r-gyro scale of −0.14 (t −5.4 and −5.8), and a
+    noise-free DHC-6 flight of the model itself for an a_y scale of −0.07 (t −3.8 and −5.6;
+    outside sweep, 2 Dec 2026). A constant is the one column a motion-following error does
+    not imitate alike in two different maneuvers."""
+    if not (_kinematics_trusted(a) and _kinematics_trusted(av)):
+        return []
+    if any(c.selected and c.effect in SENSOR_EFFECTS for c in a.candidates):
+        return []
+    p, kin = a.prepared, a.kinematic
+    twins = {c.parameter: c for c in av.candidates if c.test.startswith("kinematic consistency")}
+    named = []
+    for c in a.candidates:
+        v = twins.get(c.parameter)
+        if (c.selected or v is None or c.reason != "below the entry t" or c.effect != "sensor_bias"
+                or min(abs(c.t), abs(v.t)) < REPLICATED_EACH_T or np.sign(c.estimate) != np.sign(v.estimate)
+                or c.std_error <= 0 or v.std_error <= 0):
+            continue
+        if abs(c.estimate - v.estimate) > 2.0 * np.hypot(c.std_error, v.std_error):
+            continue
+        w1, w2 = c.std_error ** -2, v.std_error ** -2
+        est, se = (w1 * c.estimate + w2 * v.estimate) / (w1 + w2), (w1 + w2) ** -0.5
+        if abs(est) / se < KIN_T_IN or kinematic_rival(kin, c.parameter) is not None:
+            continue
+        if not sensor_verdict(c.parameter, est, se, True, kin, p, False, True)[0]:
+            continue
+        c.details["replication"] = {"identification": [c.estimate, c.std_error],
+                                    "validation": [v.estimate, v.std_error], "combined": [est, se]}
+        c.reason = (f"named on two maneuvers: the identification's kinematics suspect it (t = {c.t:.1f}, below "
+                    f"the entry t) and the validation's agree (t = {v.t:.1f}, the sizes within two standard "
+                    f"errors); together t = {est / se:.1f}")
+        c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
+        named.append(c)
+    return named
+
+
+def _kinematics_trusted(a: Analysis) -> bool:
+    """Whether a recording's kinematic consistency can judge its sensors: no turbulence
+    named, no light gusts (:func:`light_gusts`), every supported estimate plausible."""
+    turbulent = any(c.effect == "turbulence" and c.selected for c in a.candidates)
+    V0 = float(np.mean(a.prepared.smooth["V"]))
+    return not turbulent and not a.gusty and kinematics_plausible(a.kinematic, V0)

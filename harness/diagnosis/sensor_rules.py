@@ -1,0 +1,324 @@
+"""Sensor verdicts from the kinematic check: which estimates are applied and named, a scale
+that reads as a bias, the rivals and refutations the kinematics give, and the kinematic
+estimates the other rules consult."""
+from __future__ import annotations
+
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
+from harness.diagnosis import rivals
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import corrected_recording, model_along
+from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.gust_rules import NOT_IN_TURBULENCE
+from harness.diagnosis.kinematics import KinematicResult, channel_share, is_plausible, is_practical, kinematic_check
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+from harness.diagnosis.prepare import Prepared, clean_channels
+from harness.diagnosis.stepwise_axes import practical_size
+from models.aircraft import Aircraft
+from models.replay import InitialCondition
+
+
+def kinematics_plausible(kin: KinematicResult, V0: float) -> bool:
+    """Whether every kinematic estimate the data support (|t| >= :data:`APPLY_T`) is one an
+    instrument could have; an unsupported one (a lateral bias on a pitch maneuver) says
+    nothing about plausibility."""
+    return all(is_plausible(n, kin.selection.params[n], V0) or kinematic_t(kin, n) < APPLY_T
+               for n in kin.forced + kin.selection.names)
+
+
+def applied_sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool) -> dict[str, float]:
+    """The sensor corrections applied before the model is evaluated. None in turbulence or
+    when an estimate is implausible (the kinematics then disagree for another reason, and
+    the parameters were estimated together); else only those with |t| >= :data:`APPLY_T` (a
+    nuisance bias "below the entry t" may be a poorly determined 0.7 deg, and applying it
+    would move the model)."""
+    if turbulent or not plausible:
+        return {}
+    return {n: kin.selection.params[n] for n in kin.forced + kin.selection.names if kinematic_t(kin, n) >= APPLY_T}
+
+
+def sensor_verdict(name: str, est: float, se: float, entered: bool, kin: KinematicResult, p: Prepared,
+                    turbulent: bool, plausible: bool, gusty: str = "") -> tuple[bool, str]:
+    """Whether a kinematic estimate is named, and why (or why not): it must have entered,
+    matter (practical size and share of its channel's excursion), be precise, and the
+    kinematics must hold (no turbulence, no gusts that break them, plausible estimates)."""
+    practical = is_practical(name, est, p.dt) and kinematic_share(kin, name, est, p) >= cand.PRACTICAL_SHARE
+    precise = se <= max(0.5 * practical_size(name, p.dt), 0.25 * abs(est))
+    sel = entered and practical and precise and not turbulent and not gusty and plausible
+    reason = ("significant, practical and precise" if sel else "below the entry t" if not entered else
+              "within the instrument noise budget (practical size)" if not practical else
+              "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else
+              f"not applied: {gusty}" if gusty else IMPLAUSIBLE)
+    return sel, reason
+
+
+# The channels whose trim value is far from zero, where a scale factor shows as an offset:
+# the α vane (k·α at the trim α) and the airspeed (k·V).
+OFFSET_SCALE_CHANNELS = ("alpha", "V")
+
+
+def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
+    """Rename a named bias of α or V that is a scale factor's offset. A reading (1 + k)·x
+    stands k·x̄ off at the maneuver's mean x̄, which the kinematic fit (a bias always in it)
+    or the coefficient means along the vane give as a bias b, and moves k times the
+    excursions, which the kinematic fit gives as the scale k. When that k is named or
+    suspect (|t| >= :data:`AMBIGUOUS_T`) and the two say the same scale — k and b/x̄_true
+    within two standard errors of their difference — the finding is the scale, sized as
+    their inverse-variance mean, and the bias is read as its offset. A true bias leaves k
+    near zero. (An F-16 at 20,000 ft and 450 ft/s with a 10 % α-vane scale was named a 0.63°
+    α bias, b/x̄ = 0.100 ± 0.008 against k = 0.086 ± 0.022; at 427.4 ft/s the means named a
+    0.47° bias ahead of the scale the kinematics had named.) A scale the kinematics had not
+    named is judged on the validation maneuver as a finding named on two tests
+    (``details['corroboration']``: its kinematic k, same sign, |t| >= 2, within two standard
+    errors). Every bias of α or V carries its reading as a scale, b/x̄_true
+    (``details['as_scale']``), for that validation test (``run._offset_scale_check``)."""
+    for channel in OFFSET_SCALE_CHANNELS:
+        biases = [c for c in cands if c.parameter == f"bias_{channel}"]
+        bias = next((c for c in biases if c.selected), biases[0] if biases else None)
+        scale = next((c for c in cands if c.parameter == f"scale_{channel}"), None)
+        if bias is None or channel not in p.smooth:
+            continue
+        x_true = float(np.mean(p.smooth[channel])) - bias.estimate
+        if abs(x_true) <= 0.0:
+            continue
+        k_off, se_off = bias.estimate / x_true, bias.std_error / abs(x_true)
+        bias.details["as_scale"] = {"k": k_off, "k_std": se_off, "mean_true": x_true}
+        if not bias.selected or scale is None or abs(scale.t) < AMBIGUOUS_T:
+            continue
+        V_mean = float(np.mean(p.smooth["V"]))
+        if np.sign(k_off) != np.sign(scale.estimate) or \
+                abs(k_off - scale.estimate) > 2.0 * np.hypot(se_off, scale.std_error):
+            _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, V_mean)
+            continue
+        k_exc, se_exc, named = scale.estimate, scale.std_error, scale.selected
+        w = np.array([1.0 / se_off ** 2, 1.0 / se_exc ** 2])
+        k = float(np.dot(w, [k_off, k_exc]) / w.sum())
+        se = float(1.0 / np.sqrt(w.sum()))
+        if not (is_plausible(scale.parameter, k, V_mean) and is_practical(scale.parameter, k, p.dt)):
+            continue
+        scale.estimate, scale.std_error, scale.t, scale.selected = k, se, k / se, True
+        scale.reason = (f"the offset at the mean {channel} (a bias of {bias.estimate:.4g}: k = {k_off:.3f} ± "
+                        f"{se_off:.3f}) and the excursions (k = {k_exc:.3f} ± {se_exc:.3f}) agree on a scale factor")
+        scale.details["offset"] = {"bias": bias.estimate, "bias_std": bias.std_error, "mean_true": x_true,
+                                   "k": k_off, "k_std": se_off, "excursion_k": k_exc, "excursion_k_std": se_exc}
+        if not named:  # the kinematics alone had not named it: judged as named on two tests
+            scale.details["corroboration"] = {"named": True, "kinematic": k_exc, "kinematic_std": se_exc}
+        bias.selected = False
+        bias.details["read_as"] = scale.parameter
+        bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
+
+
+def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: float, se_off: float,
+                                  V_mean: float) -> None:
+    """Withhold a bias of α or V beside a scale of the same instrument that its excursions
+    show (kinematic |t| >= :data:`APPLY_T`, not named) with the sign the offset, read as a
+    scale (k = b/x̄_true, plausible), has, when the two do not agree on one scale factor
+    (:func:`scale_read_as_bias`): a scale makes an offset k·x̄ as well, so the record
+    cannot say whether the offset is a bias, the scale's, or both. (An F-16 at 420 ft/s with
+    a 10 % α-vane scale, on a pitch multisine: its coefficient means gave an offset of
+    0.50° = 0.105 ± 0.003 of the mean α, its excursions k = 0.072 ± 0.012 (t 5.9); it was
+    named a 0.50° α bias.)"""
+    if scale.selected or abs(scale.t) < APPLY_T or np.sign(scale.estimate) != np.sign(k_off) \
+            or not is_plausible(scale.parameter, k_off, V_mean):
+        return
+    bias.selected = False
+    bias.details["scale_rival"] = {"parameter": scale.parameter, "offset_k": k_off, "offset_k_std": se_off,
+                                   "excursion_k": scale.estimate, "excursion_k_std": scale.std_error}
+    bias.reason = (f"entered, but not named: {scale.parameter} would make an offset too, and the excursions show one "
+                   f"(k = {scale.estimate:.3f} ± {scale.std_error:.3f}, t = {scale.t:.1f}) that does not agree with "
+                   f"the offset read as a scale (k = {k_off:.3f} ± {se_off:.3f}): bias, scale or both")
+
+
+def withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResult, p: Prepared,
+                                      aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
+                                      noise: dict[str, float], applied: dict[str, float]) -> None:
+    """Withhold an accelerometer position fitted to the force mismatches when an α-vane
+    scale is named that was not applied to the channels the model was evaluated along: the
+    model along the scaled α is off by C_Z,α·k·α, which in a short-period motion follows q̇
+    as the position's q̇·x/g does. The position is fitted again on the mismatch along the
+    corrected α (the model evaluated once more); below the entry t there, it is withheld.
+    (At 427.4 ft/s a 10 % α scale drew a 6.9 ± 1.1 ft position beside it.) ``mismatch`` is
+    the force mismatch as evaluated, before a named position's columns were taken out."""
+    offset = next((c for c in cands if c.selected and c.parameter == "x_accelerometer"), None)
+    scale = next((c for c in cands if c.selected and c.parameter == "scale_alpha"), None)
+    if offset is None or scale is None or "scale_alpha" in applied or "scale_alpha" not in kin.parameters:
+        return
+    corrected = corrected_recording(p, kin, {"scale_alpha": scale.estimate})
+    along = model_along(corrected, aircraft, ic, inertial_from=p).mismatch()
+    refit = cand.accelerometer_offset(p, {c: along[c] for c in ("CX", "CY", "CZ")}, noise)
+    t = max(abs(v) for v in refit.t)
+    if t >= cand.T_IN:
+        return
+    offset.selected = False
+    offset.details["sensor_rival"] = "scale_alpha"
+    offset.reason = (f"fitted, but not named: along the α corrected for the named scale_alpha = {scale.estimate:.3f} "
+                     f"the force mismatch no longer asks for it (x = {refit.position_ft[0]:.2f} ± "
+                     f"{refit.std_error_ft[0]:.2f} ft, largest |t| = {t:.1f})")
+
+
+def kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool,
+                          gusty: str = "") -> list[Candidate]:
+    """The sensor candidates. The forced (nuisance) biases are tested one by one, not picked
+    as the best of many: the aerodynamic entry t serves, with the practical-size and
+    precision rules; the selected terms by the kinematic selection's own entry."""
+    out = []
+    for name in kin.forced:
+        sp = kin.parameters[name]
+        est, se = kin.selection.params[name], kin.selection.std_errors[name]
+        t = est / se if se > 0 else 0.0
+        sel, reason = sensor_verdict(name, est, se, abs(t) >= cand.T_IN, kin, p, turbulent, plausible, gusty)
+        out.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
+                             "kinematic consistency (bias always fitted)", sel, reason))
+    for term in kin.selection.terms:
+        sp = kin.parameters[term.name]
+        sel, reason = sensor_verdict(term.name, term.estimate, term.std_error, term.selected, kin, p, turbulent,
+                                      plausible, gusty)
+        out.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
+                             sp.units, "kinematic consistency", sel, reason))
+    return out
+
+
+# The |t| a kinematic estimate needs before it corrects the channels the model is evaluated on.
+APPLY_T = 3.0
+
+
+# A coefficient error on a regressor whose own sensor the kinematic check suspects at this
+# |t| (a scale factor, skew or vane offset of that channel, even below its entry t) is not
+# named: a scaled α (or β, q ...) reading is exactly a scaled derivative on α. A bias is not
+# a rival: the regression's constant absorbs it (it imitates a derivative only through the
+# model's nonlinearity).
+AMBIGUOUS_T = 2.5
+
+
+def kinematic_estimate(kin: KinematicResult, name: str) -> tuple[float, float] | None:
+    """A kinematic parameter's estimate and |t|, whether it entered the fit (its final value)
+    or not (its value when tried in the final model); None when it was not a candidate."""
+    if name in kin.selection.params:
+        return kin.selection.params[name], kinematic_t(kin, name)
+    term = next((t for t in kin.selection.terms if t.name == name), None)
+    return None if term is None else (term.estimate, abs(term.t))
+
+
+def kinematic_std_error(kin: KinematicResult, name: str) -> float:
+    """The standard error of a kinematic parameter :func:`kinematic_estimate` found."""
+    if name in kin.selection.params:
+        return float(kin.selection.std_errors.get(name, np.inf))
+    term = next(t for t in kin.selection.terms if t.name == name)
+    return float(term.std_error)
+
+
+# How far (in combined standard errors) the kinematics' own estimate of a vane's scale may
+# sit from the scale the coefficient mismatch asks for before they refute it. The mismatch's
+# k and the kinematic one come from independent equations; on the project sweep a C_Z,α error
+# asked for k = -0.069 ± 0.012 against a kinematic 0.003 ± 0.011 (4.5 apart), while a true
+# 0.08 scale at 700 ft/s asked for 0.166 ± 0.024 against a kinematic 0.066 ± 0.032 (2.5).
+VANE_REFUTE_Z = 3.5
+
+
+def kinematics_refute(kin: KinematicResult, name: str, k: float, k_std: float) -> str:
+    """Why the kinematics refute a vane scale ``k ± k_std`` the coefficient mismatch asks for:
+    their own estimate of ``name`` sits more than :data:`VANE_REFUTE_Z` combined standard
+    errors from it; an empty string when they do not (or cannot tell)."""
+    found = kinematic_estimate(kin, name)
+    if found is None or found[1] <= 0:
+        return ""
+    v, t = found
+    se = abs(v) / t
+    z = abs(k - v) / float(np.hypot(se, k_std))
+    if not np.isfinite(z) or z < VANE_REFUTE_Z:
+        return ""
+    return (f"an {name.split('_', 1)[1]} vane scale of k = {k:.3f} ± {k_std:.3f} would imitate it, but the "
+            f"kinematics put that scale at {v:.3f} ± {se:.3f} ({z:.1f} standard errors apart)")
+
+
+def kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float, float] | None:
+    """The unselected kinematic candidate most collinear with selected ``name`` (partial |r|,
+    the forced biases and the other selected terms taken out, at least
+    :data:`rivals.RIVAL_CORRELATION`), with the correlation, ``name``'s |t| beside it and the
+    rival's |t| beside ``name`` (those terms in the fit); None when there is none."""
+    cols = kin.columns or {}
+    if name not in cols:
+        return None
+    fixed = [n for n in kin.forced + kin.selection.names if n != name and n in cols]
+    F = np.column_stack([cols[n] for n in fixed]) if fixed else np.zeros((kin.start.size, 0))
+
+    def partial(x: np.ndarray) -> np.ndarray:  # x with the fixed columns' part removed
+        return x - F @ np.linalg.lstsq(F, x, rcond=None)[0] if fixed else x
+    a = partial(cols[name])
+    best = None
+    for other, col in cols.items():
+        if other in fixed or other == name or np.ptp(col) <= 0:
+            continue
+        b = partial(col)
+        r = float(np.dot(a, b) / np.sqrt(np.dot(a, a) * np.dot(b, b))) if np.dot(b, b) > 0 else 0.0
+        if abs(r) >= rivals.RIVAL_CORRELATION and (best is None or abs(r) > abs(best[1])):
+            best = (other, r)
+    if best is None:
+        return None
+    try:
+        theta, se, _ = colored_fit(kin.start, [cols[n] for n in fixed] + [cols[name], cols[best[0]]],
+                                   fixed + [name, best[0]], constant=False)
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return best[0], best[1], 0.0, 0.0
+    j = len(fixed)
+    t_own = float(abs(theta[j] / se[j])) if se[j] > 0 else 0.0
+    t_rival = float(abs(theta[j + 1] / se[j + 1])) if se[j + 1] > 0 else 0.0
+    return best[0], best[1], t_own, t_rival
+
+
+def contested_parameters(kin: KinematicResult) -> dict[str, tuple[str, float, float]]:
+    """The selected kinematic terms the kinematics cannot tell from a rival
+    (:func:`kinematic_rival`: |t| beside it below their entry t, unless it stays at least
+    :data:`AMBIGUOUS_T` there while the rival falls below it): not applied to the channels, so
+    that the coefficient mismatch can judge between the two (:func:`kinematic_rivals`)."""
+    out = {}
+    for n in kin.selection.names:
+        found = kinematic_rival(kin, n)
+        if found is None or found[2] >= KIN_T_IN:
+            continue
+        if found[2] >= AMBIGUOUS_T and found[3] < AMBIGUOUS_T:
+            continue  # beside each other, the data still prefer this one
+        out[n] = found[:3]
+    return out
+
+
+KINEMATIC_PASSES = 4
+
+
+def plausible_kinematic_check(p: Prepared) -> KinematicResult:
+    """The kinematic check, refitted without the parameters whose estimates no instrument
+    could have (:func:`kinematics.is_plausible`): nearly collinear pairs (an a_z bias and
+    scale where a_z stays near -1 g) can run to offsetting absurd values and take the true
+    sensor error with them. At most :data:`KINEMATIC_PASSES` fits; the last is returned."""
+    V0 = float(np.mean(p.smooth["V"]))
+    exclude: frozenset[str] = frozenset()
+    for _ in range(KINEMATIC_PASSES):
+        kin = kinematic_check(p, exclude=exclude)
+        bad = {n for n in kin.forced + kin.selection.names
+               if not is_plausible(n, kin.selection.params[n], V0) and kinematic_t(kin, n) >= APPLY_T}
+        bad -= set(kin.forced)  # the nuisance biases stay in every fit
+        if not bad:
+            return kin
+        exclude |= bad
+    return kin
+
+
+def kinematic_share(kin: KinematicResult, name: str, value: float, p: Prepared) -> float:
+    """The change a sensor parameter makes to its channel, as a share of the channel's
+    excursion (:func:`kinematics.channel_share`): practical significance, as for the
+    aerodynamic terms (a noise-free flight asks for a 2 ft β-vane offset at t = 69, a
+    0.01 deg change in β)."""
+    clean = clean_channels(p)
+    k = max(1, int(round(1.0 / p.dt)))
+    return channel_share(kin.parameters[name], value, clean, p, slice(k, p.n - k))
+
+
+def kinematic_t(kin: KinematicResult, name: str) -> float:
+    se = kin.selection.std_errors.get(name, 0.0)
+    return abs(kin.selection.params[name] / se) if se > 0 else 0.0
+
+
+IMPLAUSIBLE = ("not applied: the kinematic fit asks for a sensor error larger than any instrument plausibly has "
+               "(kinematics.PLAUSIBLE), so the channels disagree for another reason")

@@ -1,0 +1,348 @@
+"""The per-axis stepwise fits on the coefficient mismatch: the accelerometer position, the
+delay scans, the nuisance columns (thrust, vane noise), the moment-reference mean test,
+and the candidates the selections give, with their practical sizes."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import ModelAlong, interior
+from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.gust_rules import turbulence_test
+from harness.diagnosis.kinematics import PRACTICAL
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared
+from models.constants import SURFACES
+from models.replay import AeroAlong
+
+
+def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                      measured: dict[str, np.ndarray]) -> tuple[cand.OffsetTest, Candidate]:
+    """The accelerometer position from the force mismatches: named when significant, at
+    least 1.5 ft and at least 4 % of the force coefficients' excursion; when named, its
+    columns are removed from ``mismatch`` (in place)."""
+    off = cand.accelerometer_offset(p, mismatch, noise)
+    x, sx = off.position_ft[0], off.std_error_ft[0]
+    cols = cand.accelerometer_columns(p)
+    inner = interior(p)
+    share = max(cand.contribution_share(sum(off.position_ft[i] * cols[a][c] for i, a in enumerate("xyz"))[inner],
+                                        1.0, measured[c][inner]) for c in ("CX", "CY", "CZ"))
+    sel = (max(abs(v) for v in off.t) >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"]
+           and off.gain >= cand.MIN_GAIN / 2 and share >= cand.PRACTICAL_SHARE)
+    if sel:
+        for i, a in enumerate("xyz"):
+            for c in ("CX", "CY", "CZ"):
+                mismatch[c] = mismatch[c] - off.position_ft[i] * cols[a][c]
+    return off, Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
+                          x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", sel,
+                          "significant and practical" if sel else
+                          "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion",
+                          {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
+                           "t_xyz": list(off.t)})
+
+
+def delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
+                 noise: dict[str, float]) -> dict[str, cand.DelayScan]:
+    """A delay scan per moved surface; a delay refined beyond the scanned range is not an
+    actuator delay, and its column is not offered (it would stand in for another error)."""
+    delays = {}
+    for s in SURFACES:
+        scan = cand.delay_scan(p, s, mismatch, aero.derivatives, noise)
+        if scan is not None and scan.tau_s <= cand.DELAY_GRID_S[-1]:
+            delays[s] = scan
+    return delays
+
+
+@dataclass(frozen=True)
+class StepwiseFits:
+    selections: dict        # axis -> (ColoredSelection, {key: Term})
+    nuisances: dict         # axis -> {name: column} always in the fit
+    not_offered: dict       # axis -> terms not offered, with the reason
+    shares: dict            # (axis, key) -> share of the coefficient's excursion
+    pinned: CgMeanTest | None = None  # a moment-reference shift sized by C_m's mistrim
+
+
+# The α vane's noise column enters C_m's fit where it is a material part of the mismatch:
+# fitted alone (with a constant) it takes at least this share off C_m's mismatch RMS.
+VANE_NOISE_SHARE = 0.15
+
+
+def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mismatch: dict[str, np.ndarray],
+                        gust=None) -> dict[str, np.ndarray]:
+    """The column −C_m,α·e that the α vane's own error passes into C_m's mismatch, e the
+    vane's angle less the one the inertial channels integrate to (the kinematic residual's
+    vertical "gust" over the airspeed, high-passed at :data:`spectra.GUST_HIGHPASS_HZ`); empty
+    when the model is not evaluated along the vane (α held at its start) or when the column
+    takes less than :data:`VANE_NOISE_SHARE` off C_m's mismatch RMS. ``gust`` is the gust
+    estimate already made from these channels; None makes it again (after sensor corrections).
+
+    The model evaluated along the vane passes the vane's error through its slopes (errors in
+    variables); a Gauss-Markov wander is in the maneuver's band and survives the smoother. On a
+    slow aircraft that is a large part of C_m's mismatch: on the outside sweep's c172x nulls at
+    180 and 200 ft/s (0.1° white plus 0.1° wander at τ = 1 s) the column alone took 29-35 %
+    off it, on the F-16 0-6 %. With it, the c172x's C_m ΔV/V drift of 0.02 is named (0.0212;
+    missed before) and no other case of either sweep changed. Always in the fit it also named
+    the c172x's 0.25 ft moment-reference shift (its column takes 13 %) but drew a C_m α³ in
+    place of the DHC-6's 0.5 ft shift (5 %), hence the gate. Only C_m: the same column took
+    40-50 % off C_Z's mismatch, and the cleaner C_Z showed a C_Z ΔV/V on F-16 nulls at 550
+    and 700 ft/s and a C_Z,α̇ where a_z lagged (false findings). In gusts e is air, which the
+    aerodynamics followed: the column then fits nothing (the air-share test,
+    :func:`spectra.air_share`, is this fit on C_Z)."""
+    if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0:
+        return {}
+    if gust is None:
+        gust, _ = turbulence_test(p)
+    if gust.w_fps is None:
+        return {}
+    column = slope_of("alpha")["Cm"] * np.asarray(gust.w_fps, dtype=float) / V0   # −C_m,α·e, e = −w/V
+    inner = interior(p)
+    z = mismatch["Cm"][inner]
+    A = np.column_stack([column[inner], np.ones(z.size)])
+    left = z - A @ np.linalg.lstsq(A, z, rcond=None)[0]
+    share = 1.0 - float(np.std(left)) / max(float(np.std(z)), 1e-300)
+    return {"Cm": column} if share >= VANE_NOISE_SHARE else {}
+
+
+def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str, np.ndarray],
+              mismatch: dict[str, np.ndarray], delays: dict, vane: dict[str, np.ndarray] | None = None) -> StepwiseFits:
+    """Per-axis colored forward selection over the offered candidate terms (and the delay
+    columns), with the thrust nuisance where thrust was not recorded and the α vane's noise
+    column (:func:`vane_noise_columns`) where the model follows the vane; drift terms that
+    thrust or a propeller would imitate are not offered."""
+    selections, nuisances, not_offered, shares, pools = {}, {}, {}, {}, {}
+    inner = interior(p)
+    for axis in COEFFICIENTS:
+        terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
+        not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
+                             | ({"reason": t.details["not_offered"]} if "not_offered" in t.details else {})
+                             for t in skipped]
+        nuisance = _thrust_nuisance(p, axis, terms)
+        if vane and axis in vane:
+            nuisance["vane_alpha_noise"] = vane[axis]
+        why = NO_THRUST_DRIFT if "thrust_dV" in nuisance else PROPELLER_DRIFT if (axis in cand.LAT and propeller) \
+            else None
+        if why:
+            not_offered[axis] += [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources),
+                                   "reason": why} for t in terms if t.key == "dV"]
+            terms = [t for t in terms if t.key != "dV"]
+        extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
+        pools[axis] = (terms, extra)
+        selections[axis] = _select(p, axis, mismatch, terms, extra, nuisance, measured, shares)
+        nuisances[axis] = nuisance
+    pinned = None
+    for axis in ("Cm", "Cn"):  # C_m first: the test of either axis's shift is C_m's constant
+        test = _cg_mean_test(p, axis, selections, nuisances, mismatch, measured)
+        if test is None or not test.refuted:
+            continue
+        refit = (axis,)
+        if test.pinned and pinned is None:
+            # the shift the mistrim itself says: both its axes refitted with it taken out
+            pinned, refit = test, ("Cm", "Cn")
+            mismatch = _without_shift(p, mismatch, measured, test.dx_ft)
+        for a in refit:
+            terms, extra = pools[a]
+            terms = [t for t in terms if t.effect != "cg_offset"]
+            shares = {k: v for k, v in shares.items() if k[0] != a}
+            selections[a] = _select(p, a, mismatch, terms, extra, nuisances[a], measured, shares)
+            pools[a] = (terms, extra)
+        not_offered[axis].append({"effect": "cg_offset", "parameter": "dx_moment_reference", "sources": ["alpha"],
+                                  "reason": test.reason})
+    return StepwiseFits(selections, nuisances, not_offered, shares, pinned)
+
+
+def pinned_shift(test: CgMeanTest) -> Candidate:
+    """The moment-reference shift C_m's mistrim says (:func:`_cg_mean_test`), a candidate
+    named when significant (the entry t) and practical (the mistrim at least
+    :data:`candidates.PRACTICAL_SHARE` of C_m's excursion)."""
+    t = test.dx_ft / test.std_error_ft if test.std_error_ft > 0 else 0.0
+    sel = abs(t) >= cand.T_IN and _practical(test.share)
+    return Candidate("cg_offset", cand.AXIS_NAME["Cm"], "Cm", "dx_moment_reference", test.dx_ft, test.std_error_ft,
+                     t, test.explained, "ft", "the mistrim of C_m (its constant over the mean of C_Z)", sel,
+                     "entered" if sel else ("not entered" if abs(t) < cand.T_IN else _impractical_reason(test.share)),
+                     {"mistrim_share": test.share})
+
+
+def _without_shift(p: Prepared, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray],
+                   dx_ft: float) -> dict[str, np.ndarray]:
+    """The mismatch less what a moment-reference shift of ``dx_ft`` puts in it: Δx·C_Z/c̄ in
+    C_m and −Δx·C_Y/b in C_n (effects.md's cg_offset)."""
+    geo = p.meta["geometry"]
+    out = dict(mismatch)
+    out["Cm"] = mismatch["Cm"] - dx_ft / geo["cbar_ft"] * measured["CZ"]
+    out["Cn"] = mismatch["Cn"] + dx_ft / geo["b_ft"] * measured["CY"]
+    return out
+
+
+def _select(p: Prepared, axis: str, mismatch: dict[str, np.ndarray], terms: list, extra: dict,
+            nuisance: dict, measured: dict[str, np.ndarray], shares: dict) -> tuple:
+    """One axis's stepwise (:func:`candidates.axis_selection`), each term's share of the
+    coefficient's excursion put in ``shares``; returns ``(selection, {key: Term})``."""
+    inner = interior(p)
+    sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra, forced=nuisance)
+    by_key = {t.key: t for t in terms}
+    for t in sel.terms:
+        column = by_key[t.name].column if t.name in by_key else extra[t.name]
+        shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
+    return sel, by_key
+
+
+# A moment-reference shift Δx moves C_m by Δx·C_Z/c̄ (effects.md), so also its mean: C_Z
+# is about −C_L at trim, never near zero in level flight, and the shift mistrims the model by
+# Δx·mean(C_Z)/c̄. On the outside sweep's 11 shifts (0.25–1 ft, F-16, c172x, DHC-6) C_m's
+# mismatch mean was that to within 8 %; on its nulls it stayed under 0.006. A shift whose
+# predicted mean C_m the recording's falls short of by more than this share of the
+# prediction and :data:`CG_MEAN_Z` standard errors is refuted.
+CG_MEAN_SHARE = 0.5
+CG_MEAN_Z = 3.0
+
+
+class CgMeanTest(NamedTuple):
+    """A moment-reference shift the stepwise entered, against the mistrim of C_m."""
+
+    refuted: bool     # the recorded mistrim falls short of the one the shift predicts
+    reason: str
+    dx_ft: float      # the shift the mistrim itself says, Δx = c̄·constant/mean(C_Z)
+    std_error_ft: float
+    pinned: bool      # refuted, yet the mistrim itself is a shift of the same sign (CG_MEAN_Z)
+    share: float      # the mistrim over C_m's excursion (its practical size)
+    explained: float  # the share of C_m's mismatch (mean square, its mean included) the shift takes off
+
+
+def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
+                  mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> CgMeanTest | None:
+    """The moment-reference shift ``axis``'s stepwise entered, tested against the mean of
+    C_m's mismatch (None when none entered): the shift Δx predicts a constant
+    Δx·mean(C_Z)/c̄ in C_m beside C_m's other entered terms (a colored-residual fit with a
+    constant, Eq. 5's standard errors); a shift read off C_n's C_Y column alone on a lateral
+    maneuver is otherwise indistinguishable from C_n,β. Refuted when the constant falls
+    short of the prediction; then, if the constant is itself a shift of the prediction's sign
+    (:data:`CG_MEAN_Z` standard errors from zero), that shift is the one to name: the stepwise
+    shared the C_Z column with terms that follow α (C_Z does), oversizing it."""
+    sel, by_key = selections[axis]
+    if "cg" not in sel.names:
+        return None
+    term = by_key["cg"]
+    dx = sel.params["cg"] * term.scale
+    inner = interior(p)
+    cbar = p.meta["geometry"]["cbar_ft"]
+    cz = float(np.mean(measured["CZ"][inner]))
+    if cz == 0.0:
+        return None  # no lift on average (a zero-g arc): the mean says nothing of a shift
+    predicted = dx * cz / cbar
+    cm_sel, cm_terms = selections["Cm"]
+    cols = [cm_terms[k].column[inner] for k in cm_sel.names if k in cm_terms and k != "cg"]
+    cols += [c[inner] for c in nuisances.get("Cm", {}).values() if np.ptp(c[inner]) > 0]
+    theta, se, _ = colored_fit(mismatch["Cm"][inner], cols, [f"x{i}" for i in range(len(cols))])
+    mean, mean_se = float(theta[-1]), float(se[-1])
+    # only a mistrim short of the prediction refutes: one beyond it (a larger shift, which the
+    # other entered terms shared out) supports the shift
+    short = abs(predicted) - mean * np.sign(predicted)
+    dx_mean, se_mean = mean * cbar / cz, mean_se * cbar / abs(cz)
+    share = abs(mean) / max(float(np.std(measured["Cm"][inner])), 1e-300)
+    z = mismatch["Cm"][inner]
+    explained = 1.0 - float(np.mean((z - dx_mean / cbar * measured["CZ"][inner]) ** 2)) / max(float(np.mean(z ** 2)),
+                                                                                           1e-300)
+    if short <= CG_MEAN_SHARE * abs(predicted) or short <= CG_MEAN_Z * mean_se:
+        return CgMeanTest(False, "", dx_mean, se_mean, False, share, explained)
+    pinned = mean * np.sign(predicted) >= CG_MEAN_Z * mean_se
+    reason = (f"refuted by the mean of C_m: the shift of {dx:.3g} ft the {axis} mismatch suggests would mistrim "
+              f"C_m by {predicted:+.2g}; C_m's mismatch has a constant of {mean:+.2g} ± {mean_se:.1g}")
+    if pinned:
+        reason += f", the mistrim of a {dx_mean:.3g} ± {se_mean:.2g} ft shift, named instead"
+    return CgMeanTest(True, reason, dx_mean, se_mean, bool(pinned), share, explained)
+
+
+def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:
+    """Columns always in the fit of ``axis`` for what the thrust does outside the model's
+    aerodynamics. Without a thrust channel (thrust held at trim), CX and Cm get the airspeed
+    change: a jet's thrust changes with airspeed at a fixed throttle, in force and, through
+    the thrust line's offset from the c.g. (5.1 in on JSBSim's F-16), in pitching moment; no
+    other term may stand in for it. (With a thrust channel, Eqs. 1 and 4 use it, with the
+    metadata's ``thrust_offset_ft``.)"""
+    if axis not in ("CX", "Cm") or "thrust" in p.raw:
+        return {}
+    return {"thrust_dV": t.column for t in terms if t.key == "dV"}
+PROPELLER_DRIFT = ("the propeller's torque, P-factor and slipstream change with airspeed at a fixed throttle, "
+                   "outside the model's aerodynamic coefficients: a lateral drift term would fit them")
+NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX or Cm cannot be told from the "
+                   "thrust's own change with airspeed (its force, and its moment about the c.g.)")
+
+
+def practical_size(name: str, dt: float) -> float:
+    kind, _, channel = name.partition("_")
+    if kind == "bias":
+        return PRACTICAL["bias"].get(channel, 1.0)
+    if kind == "scale":
+        return PRACTICAL["scale"]
+    if kind == "skew":
+        return PRACTICAL["skew_samples"] * dt
+    return PRACTICAL["offset_ft"]
+
+
+# The smallest transport delay worth naming, in samples: below it a delay cannot be told from
+# sample timing (JSBSim-flown recordings show about +0.6 sample on every null flight).
+PRACTICAL_DELAY_SAMPLES = 2.0
+
+
+def _practical(share: float) -> bool:
+    return share >= cand.PRACTICAL_SHARE
+
+
+def _impractical_reason(share: float) -> str:
+    return (f"entered, but too small to matter: it explains {100 * share:.1f} % of the coefficient's excursion "
+            f"(under {100 * cand.PRACTICAL_SHARE:.0f} %)")
+
+
+def aero_candidates(selections: dict, delays: dict, dt: float,
+                     shares: dict[tuple[str, str], float] | None = None) -> list[Candidate]:
+    shares = shares or {}
+    out: list[Candidate] = []
+    delay_seen: dict[str, list] = {}
+    cg_seen: list = []
+    for axis, (sel, terms) in selections.items():
+        for t in sel.terms:
+            if t.name.startswith("delay_"):
+                delay_seen.setdefault(t.name[6:], []).append((axis, t))
+                continue
+            term = terms[t.name]
+            if term.effect == "cg_offset":
+                cg_seen.append((axis, t, term))
+                continue
+            est, se = t.estimate * term.scale, abs(t.std_error * term.scale)
+            if term.effect == "coefficient_error":
+                est = term.details["model_value"] + t.estimate
+            share = shares.get((axis, t.name), 0.0)
+            sel = t.selected and _practical(share)
+            reason = ("entered" if sel else _impractical_reason(share) if t.selected else "not entered")
+            out.append(Candidate(term.effect, cand.AXIS_NAME[axis], axis, term.parameter, est, se, t.t, t.gain,
+                                 term.units, f"stepwise on the {axis} mismatch", sel, reason,
+                                 {"change": t.estimate, "model_over_maneuver": term.details["model_value"],
+                                  "model_at_trim": term.details["trim_value"]}
+                                 if term.effect == "coefficient_error" else {}))
+    for s, rows in delay_seen.items():
+        scan = delays[s]
+        # significance from the stepwise entry of the delay column (its coefficient is τ);
+        # size and standard error from the scan's linearised fit
+        best = max(rows, key=lambda r: abs(r[1].t))[1]
+        entered = any(t.selected and _practical(shares.get((a, t.name), 0.0)) for a, t in rows)
+        inside = scan.tau_s <= cand.DELAY_GRID_S[-1]
+        sel = entered and inside and scan.tau_s >= PRACTICAL_DELAY_SAMPLES * dt
+        gain = max(t.gain for _, t in rows)
+        out.append(Candidate("control_delay", "pitch" if s == "de" else ("roll" if s == "da" else "yaw"), s, f"tau_{s}",
+                             scan.tau_s, scan.std_error, best.t, gain, "s", f"delay scan of {s} + stepwise", sel,
+                             "entered" if sel else ("not entered" if not entered else
+                                                    "entered, but the delay lies beyond the scanned 0-0.3 s: not an "
+                                                    "actuator delay" if not inside else
+                                                    "entered, but under two samples"),
+                             {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
+    if cg_seen:
+        axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))
+        sel = any(r[1].selected and _practical(shares.get((r[0], r[1].name), 0.0)) for r in cg_seen)
+        out.append(Candidate("cg_offset", cand.AXIS_NAME[axis], axis, term.parameter, t.estimate * term.scale,
+                             abs(t.std_error * term.scale), t.t, t.gain, "ft", f"stepwise on the {axis} mismatch",
+                             sel, "entered" if sel else (_impractical_reason(shares.get((axis, t.name), 0.0))
+                                                         if t.selected else "not entered")))
+    return out

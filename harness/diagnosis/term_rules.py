@@ -1,0 +1,367 @@
+"""The rules that keep an aerodynamic term from being named when something else would
+imitate it: a moment-reference shift, a change of lift, a slow lateral drift, a power of the
+wandering α vane, a rival term, a sensor error or a gyro skew."""
+from __future__ import annotations
+
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
+from harness.diagnosis import rivals
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import INERTIAL_CHANNELS, corrected_recording, inertial_beta, interior, model_along
+from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
+from harness.diagnosis.prepare import Prepared, clean_channels
+from harness.diagnosis.sensor_rules import AMBIGUOUS_T, kinematic_estimate, kinematic_std_error
+from harness.diagnosis.stepwise_axes import StepwiseFits
+from models.aircraft import Aircraft
+from models.replay import InitialCondition
+
+
+def _refit_term(z: np.ndarray, others: list[np.ndarray], column: np.ndarray) -> tuple[float, float] | None:
+    """``column``'s coefficient and t fitted on ``z`` beside ``others`` and a constant (Eq. 5's
+    colored-residual standard error); None when the columns are dependent."""
+    try:
+        theta, se, _ = colored_fit(z, others + [column], [f"o{i}" for i in range(len(others))] + ["term"])
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return None
+    k = len(others)
+    return float(theta[k]), (float(theta[k] / se[k]) if se[k] > 0 else 0.0)
+
+
+def withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
+                              p: Prepared) -> None:
+    """A moment-reference shift is one parameter acting on two axes (C_m through C_Z, C_n
+    through C_Y). Once named on one, its share of the other axis's mismatch is known; a term
+    selected on that other axis is kept only if it stays significant (|t| >= the entry t)
+    with that share removed (a 1.5 ft shift otherwise reads as a C_n,β change too)."""
+    cg = next((c for c in cands if c.selected and c.effect == "cg_offset"), None)
+    if cg is None:
+        return
+    inner = interior(p)
+    for axis, (sel, by_key) in selections.items():
+        if axis == cg.channel or "cg" not in by_key:
+            continue
+        z = mismatch[axis][inner] - cg.estimate / by_key["cg"].scale * by_key["cg"].column[inner]
+        chosen = [k for k in sel.names if k in by_key and k != "cg"]
+        for c in cands:
+            key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
+            if not c.selected or c.channel != axis or key is None:
+                continue
+            fit = _refit_term(z, [by_key[k].column[inner] for k in chosen if k != key], by_key[key].column[inner])
+            if fit is None:
+                continue  # the term's column is dependent on the others: nothing to re-test
+            t = fit[1]
+            if abs(t) < cand.T_IN:
+                c.selected = False
+                c.reason = (f"entered, but explained by the moment-reference shift named on {cg.channel} "
+                            f"({cg.estimate:.3g} ft): with its share of the {axis} mismatch removed, t = {t:.1f}")
+
+
+def lift_change_on_cx(delta_cz: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """The body-axis C_X that a change of lift carries when its C_Z share is ``delta_cz``:
+    C_X = −C_D cos α + C_L sin α and C_Z = −C_D sin α − C_L cos α, so ΔC_L alone gives
+    ΔC_Z = −ΔC_L cos α and ΔC_X = ΔC_L sin α = −ΔC_Z tan α."""
+    return -np.asarray(delta_cz, dtype=float) * np.tan(np.asarray(alpha, dtype=float))
+
+
+def withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
+                                p: Prepared) -> None:
+    """A named C_Z term may be a change of *lift* (how an aerodynamic table usually carries
+    it, and how `models.hidden` conceals a C_Z error), which also puts −ΔC_Z tan α on C_X
+    (:func:`lift_change_on_cx`): at α ≈ 8.5° a C_Z,α change of −0.6 leaves a C_X mismatch
+    following α·sin α that the stepwise named as a C_X α³ (52 ± 9, t 5.5) on a probe at
+    6,000 ft and 380 ft/s. A C_X term is kept only if it stays significant (|t| >= the
+    entry t) with that share removed, as for a moment-reference shift's second axis."""
+    named = [c for c in cands if c.selected and c.channel == "CZ" and c.test == "stepwise on the CZ mismatch"]
+    if not named or "CZ" not in selections or "CX" not in selections:
+        return
+    sel_z, by_z = selections["CZ"]
+    keys = [k for k in sel_z.names if k in by_z and any(by_z[k].parameter == c.parameter for c in named)]
+    if not keys:
+        return
+    inner = interior(p)
+    delta_cz = sum(sel_z.params[k] * by_z[k].column for k in keys)
+    z = mismatch["CX"][inner] - lift_change_on_cx(delta_cz, p.smooth["alpha"])[inner]
+    sel, by_key = selections["CX"]
+    chosen = [k for k in sel.names if k in by_key]
+    for c in cands:
+        key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
+        if not c.selected or c.channel != "CX" or key is None:
+            continue
+        fit = _refit_term(z, [by_key[k].column[inner] for k in chosen if k != key], by_key[key].column[inner])
+        if fit is None:
+            continue
+        t = fit[1]
+        if abs(t) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"entered, but explained by the C_Z change named ({', '.join(x.parameter for x in named)}) "
+                        f"read as a change of lift, whose share of C_X is −ΔC_Z tan α: with it removed, "
+                        f"t = {t:.1f}")
+
+
+def withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: StepwiseFits, p: Prepared, aircraft: Aircraft,
+                                         ic: InitialCondition) -> None:
+    """A drift term on a lateral axis (C ∝ ΔV/V) is judged along the β vane as well.
+
+    The inertial sideslip the model follows (:func:`model_states`) is placed on the vane by a
+    constant and a trend; what drift its integration keeps beyond a trend follows whatever
+    else changes slowly, and reaches the lateral mismatch through the model's β slopes. A
+    slow term is exactly what it imitates: on a probe at 10,000 ft / 427.4 ft/s (stabilator
+    and rudder together, a C_n α·β of 2 making the aircraft dive 6 % faster) the inertial β
+    drifted by 0.04° with the airspeed (correlation −0.72) and C_l ΔV/V and C_n ΔV/V entered
+    at t −7.5 and 6.2 beside the right finding, where the noise-free flight's C_l mismatch
+    is zero. The vane has no such drift (its wander is zero-mean), so the term, refitted with
+    the axis's other entered terms and nuisances on the mismatch along the vane's own β, must
+    keep the entry t and its sign."""
+    chosen = [c for c in cands if c.selected and c.effect == "flight_condition_drift" and c.channel in cand.LAT]
+    if not chosen or not inertial_beta(p):
+        return
+    inner = interior(p)
+    along_vane = model_along(p, aircraft, ic, vane_beta=True).mismatch()
+    for c in chosen:
+        sel, by_key = step.selections[c.channel]
+        names = [k for k in sel.names if k in by_key]
+        key = next((k for k in names if by_key[k].parameter == c.parameter), None)
+        if key is None:
+            continue
+        others = [by_key[k].column[inner] for k in names if k != key]
+        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
+        fit = _refit_term(along_vane[c.channel][inner], others, by_key[key].column[inner])
+        if fit is None:
+            continue
+        size, t = fit
+        if abs(t) < cand.T_IN or np.sign(size) != np.sign(sel.params[key]):
+            c.selected = False
+            c.reason = (f"entered along the inertial sideslip, whose residual drift follows slow changes such as "
+                        f"the airspeed's; along the β vane's own record t = {t:.1f}")
+
+
+def withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: StepwiseFits, p: Prepared,
+                                                 mismatch: dict[str, np.ndarray]) -> None:
+    """A named α² or α³ term must stay significant beside the linear α term when both are
+    built on the inertial α (:func:`kinematics.inertial_angles`) rather than the vane's.
+
+    The columns are built on the vane's α, whose wander is errors in variables: the linear
+    column carries the wander in full and its coefficient is pulled toward zero, while a
+    power of the perturbation hardly carries it near trim, where the wander dominates. On
+    the package's T-37 (10,000 ft, 400 ft/s) and A4 (10,000 ft, 500 ft/s) a C_m,α change of
+    −0.3 was named as a C_m α³ (−824 ± 40 and −557 ± 27), though the noise-free flights'
+    mismatch is linear to 3e-7 and an α³ fits it a thousand times worse. The inertial α
+    carries the accelerometers' noise instead, which the vane term does not share; the
+    question asked of it is only which shape, with the axis's other entered terms and
+    nuisances beside both columns."""
+    chosen = [c for c in cands if c.selected and c.effect == "nonlinear_alpha" and c.channel in step.selections]
+    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
+        return
+    inner = interior(p)
+    da = inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"]
+    for c in chosen:
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
+        if key is None:
+            continue
+        power = 2 if key == "alpha2" else 3
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k not in (key, "alpha")]
+        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
+        fit = _refit_term(mismatch[c.channel][inner], others + [da[inner]], da[inner] ** power)
+        if fit is None:
+            continue
+        if abs(fit[1]) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"entered, but beside the linear α term, both built on the inertial α (free of the vane's "
+                        f"wander, which favours a power of α), t = {fit[1]:.1f}")
+
+
+def kinematic_bias_of(kin: KinematicResult, channel: str, applied: set[str]) -> tuple[float, float]:
+    """The kinematic estimate of a vane bias and its standard error (0 ± s.e. once the
+    channels were corrected for it); an infinite s.e. when the check had no such bias."""
+    name = f"bias_{channel}"
+    if name not in kin.selection.params:
+        return 0.0, np.inf
+    se = kin.selection.std_errors.get(name, np.inf)
+    return (0.0 if name in applied else kin.selection.params[name]), (se if se > 0 else np.inf)
+
+
+def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
+                     p: Prepared, slope_of, kin: KinematicResult, applied: set[str], V0: float) -> None:
+    """Deselect the aerodynamic terms the data cannot tell from a rival (:mod:`rivals`): a
+    collinear candidate of the same axis, or a vane bias the kinematics cannot rule out. A
+    term that survives keeps its strongest collinear rival in ``details['rival']`` for the
+    validation maneuver to judge."""
+    inner = interior(p)
+    for c in cands:
+        if not c.selected or c.channel not in selections:
+            continue
+        sel, by_key = selections[c.channel]
+        key = next((k for k, t in by_key.items() if t.parameter == c.parameter and k in sel.names), None)
+        if key is None:
+            continue
+        z = mismatch[c.channel][inner]
+        columns = {k: t.column[inner] for k, t in by_key.items()}
+        pool = [k for k in columns if k not in sel.names]
+        columns.update({k: col[inner] for k, col in nuisances.get(c.channel, {}).items() if np.ptp(col[inner]) > 0})
+        others = [n for n in sel.names if n != key and n in columns]
+        others += [k for k in nuisances.get(c.channel, {}) if k in columns]
+        rival = rivals.strongest_rival(z, columns, key, others, pool)
+        if rival is not None:
+            rt = by_key[rival.key]
+            c.details["rival"] = {"parameter": rt.parameter, "effect": rt.effect, "axis": c.channel,
+                                  "correlation": rival.correlation, "t_term": rival.t_term,
+                                  "t_rival": rival.t_rival, "coefficient": rival.swapped}
+            if abs(rival.t_term) < cand.T_IN:
+                # the identification maneuver cannot tell them apart: a finding only if the
+                # validation maneuver prefers it (run.validation_check), never without one
+                c.details["rival"]["indistinct"] = (
+                    f"the identification maneuver cannot tell it from {rt.parameter} (columns correlated "
+                    f"{rival.correlation:+.2f}; beside it, t = {rival.t_term:.1f})")
+        for x in rivals.BIAS_SOURCES:
+            if x not in by_key[key].sources:
+                continue
+            b = rivals.bias_rival(z, columns[key], [columns[n] for n in others], slope_of(x)[c.channel][inner], x,
+                                  kinematic_bias_of(kin, x, applied))
+            if (b is not None and abs(b.t_term) < cand.T_IN and not b.ruled_out
+                    and is_plausible(f"bias_{x}", b.bias_rad, V0)):
+                c.selected = False
+                c.details["sensor_rival"] = f"bias_{x}"
+                c.reason = (f"entered, but not named: a {x} vane bias of {np.degrees(b.bias_rad):.2f} deg would "
+                            f"imitate it through the model's nonlinearity (beside it, t = {b.t_term:.1f}), and the "
+                            f"kinematics cannot rule that bias out ({_bias_text(b)})")
+                break
+
+
+def _bias_text(b: rivals.BiasRival) -> str:
+    if not np.isfinite(b.kinematic_std):
+        return f"they do not test a {b.channel} bias"
+    return f"bias_{b.channel} = {np.degrees(b.kinematic):.2f} ± {np.degrees(b.kinematic_std):.2f} deg"
+AMBIGUOUS_KINDS = ("scale", "skew", "vane")
+# The instrument each coefficient is measured with (seed Eqs. 1, 3-5): a skew of it imitates
+# an α̇ or rate term of that coefficient (ΔC ≈ −τ dC/dt follows the rates), a scale every term.
+DEPENDENT_SENSOR = {"CX": "ax", "CY": "ay", "CZ": "az", "Cl": "p", "Cm": "q", "Cn": "r"}
+
+
+# The rate each surface mainly drives: a time skew of that rate's channel makes the surface
+# look late by the same amount.
+SURFACE_RATE = {"de": "q", "da": "p", "dr": "r"}
+
+
+def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
+    """Deselect a control delay the kinematics cannot tell from a time skew of the rate its
+    surface drives: a gyro that lags imitates an actuator that lags (the coefficient measured
+    from the lagging rate's derivative, less the model along the lagging rate, leaves the
+    surface's term late by the same time). Withheld when the kinematic skew lies within two
+    standard errors of the delay (both estimates' errors combined: they do not rule a skew of
+    that size out), or shows (|t| >= :data:`AMBIGUOUS_T`, same sign) within 30 % of it. A
+    skew the kinematics could not test (the rate hardly moves) leaves the delay named, with
+    the caveat in ``details['not_ruled_out']``."""
+    rate = SURFACE_RATE.get(c.channel, "")
+    name = f"skew_{rate}"
+    found = kinematic_estimate(kin, name)
+    if found is None:
+        c.details["not_ruled_out"] = (f"a {rate}-gyro lag of the same size would look alike; the kinematic check did "
+                                      f"not test one ({name} not offered)")
+        return
+    skew, t = found
+    se_skew = kinematic_std_error(kin, name)
+    se_diff = float(np.hypot(c.std_error, se_skew))
+    gap = abs(skew - c.estimate)
+    shows = t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and gap <= 0.3 * abs(c.estimate)
+    if gap <= 2.0 * se_diff or shows:
+        c.selected = False
+        c.details["sensor_rival"] = name
+        c.reason = (f"entered, but not named: the kinematics show the {rate} channel lagging by {skew:.3f} ± "
+                    f"{se_skew:.3f} s ({name}, t = {t:.1f}), which "
+                    + ("looks like this delay" if t >= AMBIGUOUS_T else "does not rule out a lag of this size"))
+
+
+# A suspected sensor error withholds a term only if, anywhere within IMITATION_Z standard
+# errors of its kinematic estimate, it would imitate at least IMITATION_SHARE of the term's
+# change (in the change's direction).
+IMITATION_Z = 3.0
+IMITATION_SHARE = 0.5
+
+
+def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
+               mismatch: dict[str, np.ndarray], step: StepwiseFits):
+    """``imitated(c, name)``: the largest change of term ``c``'s parameter, in the direction of
+    its own change, that sensor error ``name`` imitates anywhere within :data:`IMITATION_Z`
+    standard errors of its kinematic estimate; None when it cannot be computed.
+
+    The imitation is computed, not assumed: the channels are corrected by the kinematic
+    estimate v, the measured and the model's coefficients evaluated again, and the mismatch's
+    change fitted on the term's column beside the axis's other selected terms and a constant
+    (ordinary least squares): δ per v, linear in the error's size. (A 2.3 % q-scale suspicion,
+    kinematic t = 2.6, withheld a C_m,q̂ change of −5.9 on the model's −0.95 at 380 ft/s: such a
+    scale imitates 0.4 at most.)"""
+    inner = interior(p)
+
+    def imitated(c: Candidate, name: str) -> float | None:
+        found = kinematic_estimate(kin, name)
+        sel, by_key = step.selections.get(c.channel, (None, {}))
+        key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
+        change = c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
+        if found is None or key is None or not found[0] or not change:
+            return None
+        v, t = found
+        changed = model_along(corrected_recording(p, kin, {name: v}), aircraft, ic, inertial_from=p).mismatch()
+        z = (mismatch[c.channel] - changed[c.channel])[inner]   # what an error of size v adds
+        cols = [by_key[key].column[inner]] + [by_key[k].column[inner] for k in sel.names if k != key and k in by_key]
+        A = np.column_stack(cols + [np.ones(z.size)])
+        per_v = float(np.linalg.lstsq(A, z, rcond=None)[0][0]) / v
+        sigma = abs(v) / t if t > 0 else np.inf
+        ends = (v - IMITATION_Z * sigma, v + IMITATION_Z * sigma)
+        return max(per_v * e * np.sign(change) for e in ends)
+    return imitated
+
+
+def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None) -> None:
+    """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
+    channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
+    kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
+    reason names the rival."""
+
+    def explains(c: Candidate, rival: str, t: float) -> bool:
+        if c.details.get("sensor_suspect", {}).get("parameter") == rival:
+            return False  # asked already (the regressor's sensor and the coefficient's)
+        size = None if imitated is None else imitated(c, rival)
+        change = abs(c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate)
+        if size is None or size >= IMITATION_SHARE * change:
+            return True
+        c.details["sensor_suspect"] = {"parameter": rival, "imitates_at_most": size, "change": change}
+        c.reason += (f"; the kinematics suspect {rival} (t = {t:.1f}), which would imitate at most {size:.2g} of "
+                     f"this change of {change:.3g}")
+        return False
+    suspects: dict[str, tuple[str, float]] = {}
+    for name, sp in kin.parameters.items():
+        found = kinematic_estimate(kin, name)
+        if found is not None and name.split("_", 1)[0] in AMBIGUOUS_KINDS:
+            t = found[1]
+            if t >= AMBIGUOUS_T and t > suspects.get(sp.channel, ("", 0.0))[1]:
+                suspects[sp.channel] = (name, t)
+    for c in cands:
+        if c.selected and c.effect == "control_delay":
+            _withhold_skewed_delay(c, kin)
+        if not (c.selected and c.effect == "coefficient_error"):
+            continue
+        channel = cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
+        if channel in suspects and explains(c, *suspects[channel]):
+            rival, t = suspects[channel]
+            c.selected = False
+            c.details["sensor_rival"] = rival
+            c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({rival}, "
+                        f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
+    for c in cands:  # the sensor the coefficient itself is measured with
+        sensor = DEPENDENT_SENSOR.get(c.channel or "")
+        if not (c.selected and sensor in suspects and c.test.startswith("stepwise")):
+            continue
+        rival, t = suspects[sensor]
+        rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
+        if rival.startswith("skew") and not (c.effect == "unsteady_alphadot" or rate_term):
+            continue  # a lag imitates terms that follow the coefficient's rate of change, not its level
+        if not explains(c, rival, t):
+            continue
+        c.selected = False
+        c.details["sensor_rival"] = rival
+        c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
+                    f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
