@@ -49,7 +49,7 @@ def user_errors() -> tuple[type[BaseException], ...]:
     malformed recording, input spec, equation, campaign, column map, output-error model...), a
     failed trim or flight, a failed diagnosis, running out of memory and an unusable path.
     Imported lazily: some of these modules import this one."""
-    from harness.diagnosis.run import DiagnosisError
+    from harness.diagnosis.verdict import DiagnosisError
     from models.flight import FlightError
     from models.trim import TrimError
     return (UserError, TrimError, FlightError, DiagnosisError, MemoryError) + _PATH_ERRORS

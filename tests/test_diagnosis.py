@@ -12,7 +12,8 @@ from estimators.colored_stepwise import colored_forward_selection
 from estimators.smoothing import sine_series_derivative
 from harness.diagnosis.fits import theil_u, whiteness
 from harness.diagnosis.gallery import CASES, case, write_case
-from harness.diagnosis.run import DiagnosisError, diagnose
+from harness.diagnosis.run import diagnose
+from harness.diagnosis.verdict import DiagnosisError
 
 AFFECTED = {"unsteady_alphadot": "q", "control_delay": "q", "sensor_offset": "az", "nonlinear_alpha": "q",
             "coefficient_error": "q", "cg_offset": "q", "sensor_bias": "alpha"}

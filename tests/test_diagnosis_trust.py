@@ -8,7 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from harness.diagnosis.run import DiagnosisError, diagnose
+from harness.diagnosis.run import diagnose
+from harness.diagnosis.verdict import DiagnosisError
 from harness.noise import apply_noise
 from harness.noise_presets import preset
 from harness.recording_io import write_recording
@@ -132,11 +133,11 @@ def test_a_state_that_drifts_without_its_input_is_evaluated_along_not_fitted():
 
 
 def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
-    """run._unsupported_in_the_loop: a used calibration that sizes a named term within 3
+    """augmented.unsupported_in_the_loop: a used calibration that sizes a named term within 3
     standard errors of no change withdraws it (status 'unsupported', the validation status
     kept beside it); a term it sizes clearly, or an unused calibration, withdraws nothing."""
     from harness.diagnosis.evidence import Candidate
-    from harness.diagnosis.run import CALIBRATED_MIN_Z, _unsupported_in_the_loop
+    from harness.diagnosis.augmented import CALIBRATED_MIN_Z, unsupported_in_the_loop
 
     def cand(parameter, estimate):
         return Candidate("cross_coupling", "roll", "Cl", parameter, estimate, 0.29, -5.7, 0.5, "per rad^2",
@@ -145,21 +146,21 @@ def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
     weak, strong = cand("Cl_alpha_beta", -1.66), cand("Cn_beta_abs", 0.2)
     sized = {"Cl_alpha_beta": {"size": -0.0165, "std_error": 0.015}, "Cn_beta_abs": {"size": 0.19, "std_error": 0.01}}
     checks = {id(weak): {"status": "confirmed", "axes": ["Cl"]}}
-    assert _unsupported_in_the_loop([weak, strong], {"used": False, "findings": sized}, checks) == []
-    assert _unsupported_in_the_loop([weak, strong], {"used": True, "findings": sized}, checks) == [weak]
+    assert unsupported_in_the_loop([weak, strong], {"used": False, "findings": sized}, checks) == []
+    assert unsupported_in_the_loop([weak, strong], {"used": True, "findings": sized}, checks) == [weak]
     assert checks[id(weak)]["status"] == "unsupported" and checks[id(weak)]["validation_status"] == "confirmed"
     assert f"within {CALIBRATED_MIN_Z:g} standard errors" in checks[id(weak)]["reason"]
     assert id(strong) not in checks
 
 
 def test_the_model_mass_assumption_names_how_far_the_recording_is():
-    """run._mass_difference: the recording's mass and inertias against the model's, named
+    """verdict._mass_difference: the recording's mass and inertias against the model's, named
     when 2 % or more apart (the coefficients use the recording's, the replays the model's)."""
     from types import SimpleNamespace
 
     import numpy as np
 
-    from harness.diagnosis.run import _mass_difference
+    from harness.diagnosis.verdict import _mass_difference
     trim = SimpleNamespace(mass_slug=600.0, Ix_slugft2=9000.0, Iy_slugft2=55000.0, Iz_slugft2=63000.0)
     same = {"mass_slug": np.full(3, 600.0), "Ix_slugft2": np.full(3, 9050.0), "Iy_slugft2": 55000.0}
     assert _mass_difference(same, trim) == ""
@@ -267,7 +268,7 @@ def test_the_kinematics_refute_a_vane_scale_they_do_not_see():
     assert "kinematics put that scale at 0.003" in why
     assert kinematics_refute(kin(0.066, 0.032), "scale_alpha", 0.166, 0.024) == ""
     assert kinematics_refute(SimpleNamespace(selection=SimpleNamespace(params={}, terms=[])), "scale_alpha",
-                              -0.069, 0.0115) == ""
+                             -0.069, 0.0115) == ""
 
 
 def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypatch):
@@ -317,9 +318,9 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
 
 
 def test_an_accelerometer_offset_is_explained_along_its_own_axis():
-    """run._offset_direction: a lateral offset is 'right of' or 'left of' the c.g. (y), a
+    """verdict._offset_direction: a lateral offset is 'right of' or 'left of' the c.g. (y), a
     vertical one 'below' or 'above' (z, body axes down), the force fit's x 'ahead of'."""
-    from harness.diagnosis.run import _offset_direction
+    from harness.diagnosis.verdict import _offset_direction
     assert _offset_direction("offset_y", 3.9) == ("y", "right of")
     assert _offset_direction("offset_y", -3.9) == ("y", "left of")
     assert _offset_direction("offset_z", 2.0) == ("z", "below")
@@ -399,16 +400,16 @@ def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
 
 
 def test_a_sensor_finding_the_validation_contradicts_says_what_the_same_test_gave_there():
-    """run._finding_dict: a sensor test's check carries no mismatch 'change' (a KeyError, an
+    """verdict.finding_dict: a sensor test's check carries no mismatch 'change' (a KeyError, an
     internal error, before); the text gives the estimate the same test made on the
     validation maneuver."""
     from harness.diagnosis.evidence import Candidate
-    from harness.diagnosis.run import _finding_dict
+    from harness.diagnosis.verdict import finding_dict
     f = Candidate("sensor_bias", None, "beta", "bias_beta", 0.0184, 6e-5, 300.0, 0.0, "rad",
                   "lateral coefficient means along the β vane", selected=True)
     check = {"status": "contradicted", "axes": ["CY", "Cl", "Cn"], "estimate": -0.00698, "std_error": 4.3e-05,
              "t": -162.9}
-    text = _finding_dict(f, {}, {}, check)["explanation"]
+    text = finding_dict(f, {}, {}, check)["explanation"]
     assert "the same test there gives -0.00698 ± 4.3e-05 rad, t = -162.9" in text
 
 
@@ -510,7 +511,7 @@ def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
 
 
 def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematics():
-    """run._vane_means_check: where the validation maneuver's kinematics gave the vane bias
+    """validation._vane_means_check: where the validation maneuver's kinematics gave the vane bias
     themselves (so its coefficient-means test did not run), their estimate decides as for any
     sensor finding: the same sign at |t| >= SENSOR_CONFIRM_T confirms, the opposite sign at
     that |t| contradicts, a weaker one is neutral; not when they also name a scale of that
@@ -518,7 +519,7 @@ def test_a_vane_bias_named_on_the_means_is_confirmed_by_the_validation_kinematic
     from types import SimpleNamespace
 
     from harness.diagnosis.evidence import Candidate
-    from harness.diagnosis.run import SENSOR_CONFIRM_T, _vane_means_check
+    from harness.diagnosis.validation import SENSOR_CONFIRM_T, _vane_means_check
     named = Candidate("sensor_bias", "lon", "alpha", "bias_alpha", 0.0173, 0.0006, 28.0, 0.0, "rad",
                       "longitudinal coefficient means along the α vane", True)
 
@@ -572,8 +573,8 @@ def test_a_control_delay_the_kinematics_cannot_tell_from_a_gyro_skew_is_withheld
     assert not weak.selected and "does not rule out a lag of this size" in weak.reason
     assert ruled_out.selected and opposite.selected
     assert untested.selected and "q-gyro lag" in untested.details["not_ruled_out"]
-    from harness.diagnosis.run import _finding_dict
-    said = _finding_dict(untested, {}, {})
+    from harness.diagnosis.verdict import finding_dict
+    said = finding_dict(untested, {}, {})
     assert said["explanation"].endswith("Caveat: " + untested.details["not_ruled_out"] + ".")
     assert said["evidence"]["not_ruled_out"] == untested.details["not_ruled_out"]
 
@@ -620,14 +621,14 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
 
 
 def test_a_scale_named_on_its_offset_is_tested_the_same_way_on_the_validation_maneuver():
-    """run._offset_scale_check: a scale named on its offset and excursions together is
+    """validation._offset_scale_check: a scale named on its offset and excursions together is
     confirmed where the validation maneuver's offset (read as k = b/x̄_true, 0.12 ± 0.013)
     and excursions (0.048 ± 0.036, t 1.3: 'neutral' alone) agree: their inverse-variance
     mean, t >= 3 with the same sign. Where they disagree there is no verdict."""
     from types import SimpleNamespace
 
     from harness.diagnosis.evidence import Candidate
-    from harness.diagnosis.run import _offset_scale_check, _sensor_check
+    from harness.diagnosis.validation import _offset_scale_check, _sensor_check
 
     def validation(k_exc, se_exc):
         bias = Candidate("sensor_bias", None, "alpha", "bias_alpha", 0.0068, 0.00074, 9.2, 0.0, "rad",
@@ -648,10 +649,10 @@ def test_a_scale_named_on_its_offset_is_tested_the_same_way_on_the_validation_ma
 
 
 def test_rms_margin_is_two_standard_errors_of_an_ar1_records_rms():
-    """run.rms_margin: 2/√(2 n_eff) with n_eff = N(1 − ρ)/(1 + ρ) (Bartlett). A seeded AR(1)
+    """validation.rms_margin: 2/√(2 n_eff) with n_eff = N(1 − ρ)/(1 + ρ) (Bartlett). A seeded AR(1)
     record with ρ = 0.6 and N = 20,000 has n_eff = 5,000 and a margin of 0.02; the lag-one
     estimate's own error (√((1 − ρ²)/N) = 0.0057) moves it by under 2 %."""
-    from harness.diagnosis.run import rms_margin
+    from harness.diagnosis.validation import rms_margin
     rng = np.random.default_rng(12)
     e = rng.standard_normal(20_000)
     x = np.empty_like(e)
@@ -673,18 +674,18 @@ def test_rms_margin_is_two_standard_errors_of_an_ar1_records_rms():
 ])
 def test_a_rival_overturns_a_finding_by_the_validation_records_sampling_error(own, theirs, indistinct, change,
                                                                               expected):
-    """run.rival_fits_as_well with a margin of 30 % (two standard errors of the RMS). Measured
+    """validation.rival_fits_as_well with a margin of 30 % (two standard errors of the RMS). Measured
     cases: a C_m,α −0.15 at 18,000 ft / 420 ft/s, set apart from a moment-reference shift
     (|t| 5.2 beside it), lowers the validation RMS by 70 % and the shift by 1 % more: the
     finding stands. A C_m ΔV/V on a DHC-6 multisine null, set apart from a C_m α³, lowers
     the validation RMS by 5 % against a 53 % margin: the α³'s 3 % better fit leaves it
     ambiguous (it was a false finding when a distinct rival needed a significant win)."""
-    from harness.diagnosis.run import rival_fits_as_well
+    from harness.diagnosis.validation import rival_fits_as_well
     assert rival_fits_as_well(own, theirs, 0.30, indistinct, change) is expected
 
 
 def test_the_ambiguous_reason_says_which_rule_left_the_finding_undecided():
-    from harness.diagnosis.run import _ambiguous_reason
+    from harness.diagnosis.validation import _ambiguous_reason
     rival = {"parameter": "Cm_de", "correlation": -0.93, "noise_levels_own": 1.60, "noise_levels_rival": 1.59,
              "margin": 0.41, "indistinct": ""}
     text = _ambiguous_reason(rival, -0.15)
@@ -792,13 +793,13 @@ def test_a_lateral_drift_term_the_beta_vane_does_not_show_is_withheld(monkeypatc
 
 
 def test_a_validation_maneuver_that_does_not_excite_a_term_leaves_it_untested():
-    """run.untestable: a sequential three-axis maneuver drives α and β but not together, so an
+    """validation.untestable: a sequential three-axis maneuver drives α and β but not together, so an
     α·β coupling is untested there while C_l,β is tested; on a stabilator-only maneuver (β, p,
     r not driven) a C_l,β or C_n α·β finding is tested as before (a maneuver of another kind;
     the noise it meets leaves the finding unconfirmed), and so is C_m,q̂."""
     from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.prepare import prepare
-    from harness.diagnosis.run import untestable
+    from harness.diagnosis.validation import untestable
 
     def finding(channel, parameter, effect="coefficient_error"):
         return Candidate(effect, "roll", channel, parameter, 0.0, 1.0, 10.0, 0.5, "per rad",

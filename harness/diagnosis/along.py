@@ -110,7 +110,7 @@ def interior(p: Prepared) -> slice:
 
 
 def slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],
-                    surfaces: dict[str, np.ndarray], alphadot: np.ndarray | None, aero: AeroAlong):
+                   surfaces: dict[str, np.ndarray], alphadot: np.ndarray | None, aero: AeroAlong):
     """``slope_of(x)``: the model's ∂C/∂x along the states (:mod:`rivals`), evaluated on first
     use and kept."""
     slopes: dict[str, dict[str, np.ndarray]] = {}

@@ -97,7 +97,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
             for vane in VANE_MEANS_AXES:
                 name_vane_bias_from_means(cands, kin, p, aircraft, ic, step, vane,
-                                           sensor_values.get(f"bias_{vane}", 0.0))
+                                          sensor_values.get(f"bias_{vane}", 0.0))
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
             scale_read_as_bias(cands, recorded)

@@ -33,7 +33,7 @@ class Candidate:
 
     def as_dict(self) -> dict:
         d = {k: getattr(self, k) for k in ("effect", "axis", "channel", "parameter", "estimate", "std_error", "t",
-                                            "explained_fraction", "units", "selected", "reason")}
+                                           "explained_fraction", "units", "selected", "reason")}
         d["test"] = self.test
         return {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in d.items()}
 

@@ -25,7 +25,7 @@ def turbulence_test(p: Prepared):
 
 
 def air_share_test(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, slope_of, gust,
-               V0: float) -> AirShare:
+                   V0: float) -> AirShare:
     """The air-share test (:func:`spectra.air_share`) on C_Z and the vertical gust, along
     the α vane's own record, with the model's C_Z,α from ``slope_of`` (:func:`slope_function`
     along ``along``): where the maneuver did not drive α the model holds it at its start
@@ -119,7 +119,7 @@ def withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:
 
 
 def spectral_candidates(peak, gust, turbulent: bool, light: bool = False,
-                         air: AirShare | None = None) -> list[Candidate]:
+                        air: AirShare | None = None) -> list[Candidate]:
     """The structural-mode peak (named at p < :data:`FISHER_P`) and the gust level (named in
     turbulence, and in light turbulence the air-share test confirms: then the part of the
     vertical gust that is air, σ_w √(1 − k))."""
@@ -166,6 +166,8 @@ def withhold_in_turbulence(cands: list[Candidate]) -> None:
                            or c.parameter == "x_accelerometer"):
             c.selected = False
             c.reason = NOT_IN_GUSTS
+
+
 GUST_RATIO = 4.0     # the integrated kinematic residual over what sensor noise alone gives
 GUST_MIN_FPS = 3.0   # and at least light turbulence's RMS gust
 # Gusts below GUST_MIN_FPS still void the sensor tests when their angle σ/V is this many times

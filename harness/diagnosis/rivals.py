@@ -10,7 +10,7 @@ choice is a coin toss the report must not present as a finding. Two kinds of riv
   stays significant with the rival in the fit, |t| >= the entry t
   (:data:`harness.diagnosis.candidates.T_IN`). Its rival's size when fitted *in its place*
   is kept, so that the validation maneuver can say which of the two predicts better
-  (``run.validation_check``).
+  (``validation.validation_check``).
 * **A bias of the α or β vane** that the kinematic check cannot rule out. The model is
   evaluated along the measured angle; a vane reading Δx high shifts the model's
   coefficients by its local slope times Δx, ``∂C/∂x(t)·Δx``. The constant part goes into

@@ -25,7 +25,7 @@ from models.replay import InitialCondition
 
 
 def signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
-                      ic: InitialCondition, mismatch: dict[str, np.ndarray], step: StepwiseFits):
+                     ic: InitialCondition, mismatch: dict[str, np.ndarray], step: StepwiseFits):
     """``ratios(name, value, skip)``: per axis, the multiple of the mismatch change that
     correcting the channels by sensor parameter ``name`` = ``value`` makes (the model evaluated
     again along the corrected channels, :mod:`corroborate`), fitted beside the axis's named
@@ -72,7 +72,7 @@ PROBE_SCALE = 0.05
 
 
 def withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: StepwiseFits, signature,
-                         inertial: bool = False) -> None:
+                        inertial: bool = False) -> None:
     """Deselect coefficient errors on α or β that a scale error of that vane would imitate on
     every axis that can tell (:func:`corroborate.imitates`): the model evaluated along a
     scaled angle is off by each coefficient's own slope times the scaled excursion, so a
@@ -138,7 +138,7 @@ def birge_scaled(ag: corroborate.Agreement) -> float:
 
 
 def name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
-                               ic: InitialCondition, step: StepwiseFits, channel: str, applied: float = 0.0) -> None:
+                              ic: InitialCondition, step: StepwiseFits, channel: str, applied: float = 0.0) -> None:
     """Name a vane bias (``channel``; :data:`VANE_MEANS_AXES`) from the coefficients' means
     along the vane.
 
@@ -185,7 +185,7 @@ def name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: P
 
 
 def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature, applied: set[str],
-                       V0: float) -> None:
+                      V0: float) -> None:
     """Name a suspected sensor error (kinematic |t| >= :data:`AMBIGUOUS_T`, below the kinematic
     entry t), whether or not it kept a coefficient term from being named, when the coefficient
     mismatch independently shows the same error on every axis that can tell
@@ -214,7 +214,7 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
 
 
 def kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature,
-                      contested: dict[str, tuple[str, float, float]]) -> None:
+                     contested: dict[str, tuple[str, float, float]]) -> None:
     """A sensor error the kinematics name is kept only when they tell it from its most
     collinear rival (|t| >= their entry t beside it): on a pitch maneuver an α scale factor
     and an a_z skew both follow α̇ in the ẇ equation. When they cannot, the coefficient
@@ -272,8 +272,8 @@ def _withhold_absorbed_biases(cands: list[Candidate], kin: KinematicResult, drop
 
 
 def name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepared, p: Prepared,
-                  aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
-                  removed: dict[str, np.ndarray], step: StepwiseFits, applied: dict[str, float], V0: float) -> None:
+                 aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
+                 removed: dict[str, np.ndarray], step: StepwiseFits, applied: dict[str, float], V0: float) -> None:
     """Name a sensor error that was applied to the channels (|t| >= :data:`APPLY_T`) but is
     below its entry t, when the coefficient mismatch corroborates it (:mod:`corroborate`):
     here the mismatch *without* the correction is fitted on the change the correction made

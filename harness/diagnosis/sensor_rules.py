@@ -40,7 +40,7 @@ def applied_sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool
 
 
 def sensor_verdict(name: str, est: float, se: float, entered: bool, kin: KinematicResult, p: Prepared,
-                    turbulent: bool, plausible: bool, gusty: str = "") -> tuple[bool, str]:
+                   turbulent: bool, plausible: bool, gusty: str = "") -> tuple[bool, str]:
     """Whether a kinematic estimate is named, and why (or why not): it must have entered,
     matter (practical size and share of its channel's excursion), be precise, and the
     kinematics must hold (no turbulence, no gusts that break them, plausible estimates)."""
@@ -73,7 +73,7 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
     named is judged on the validation maneuver as a finding named on two tests
     (``details['corroboration']``: its kinematic k, same sign, |t| >= 2, within two standard
     errors). Every bias of α or V carries its reading as a scale, b/x̄_true
-    (``details['as_scale']``), for that validation test (``run._offset_scale_check``)."""
+    (``details['as_scale']``), for that validation test (``validation._offset_scale_check``)."""
     for channel in OFFSET_SCALE_CHANNELS:
         biases = [c for c in cands if c.parameter == f"bias_{channel}"]
         bias = next((c for c in biases if c.selected), biases[0] if biases else None)
@@ -132,8 +132,8 @@ def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: floa
 
 
 def withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResult, p: Prepared,
-                                      aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
-                                      noise: dict[str, float], applied: dict[str, float]) -> None:
+                                     aircraft: Aircraft, ic: InitialCondition, mismatch: dict[str, np.ndarray],
+                                     noise: dict[str, float], applied: dict[str, float]) -> None:
     """Withhold an accelerometer position fitted to the force mismatches when an α-vane
     scale is named that was not applied to the channels the model was evaluated along: the
     model along the scaled α is off by C_Z,α·k·α, which in a short-period motion follows q̇
@@ -159,7 +159,7 @@ def withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResul
 
 
 def kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool,
-                          gusty: str = "") -> list[Candidate]:
+                         gusty: str = "") -> list[Candidate]:
     """The sensor candidates. The forced (nuisance) biases are tested one by one, not picked
     as the best of many: the aerodynamic entry t serves, with the practical-size and
     precision rules; the selected terms by the kinematic selection's own entry."""
@@ -174,7 +174,7 @@ def kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, pla
     for term in kin.selection.terms:
         sp = kin.parameters[term.name]
         sel, reason = sensor_verdict(term.name, term.estimate, term.std_error, term.selected, kin, p, turbulent,
-                                      plausible, gusty)
+                                     plausible, gusty)
         out.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
                              sp.units, "kinematic consistency", sel, reason))
     return out

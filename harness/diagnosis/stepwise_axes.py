@@ -20,7 +20,7 @@ from models.replay import AeroAlong
 
 
 def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
-                      measured: dict[str, np.ndarray]) -> tuple[cand.OffsetTest, Candidate]:
+                     measured: dict[str, np.ndarray]) -> tuple[cand.OffsetTest, Candidate]:
     """The accelerometer position from the force mismatches: named when significant, at
     least 1.5 ft and at least 4 % of the force coefficients' excursion; when named, its
     columns are removed from ``mismatch`` (in place)."""
@@ -45,7 +45,7 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
 
 
 def delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
-                 noise: dict[str, float]) -> dict[str, cand.DelayScan]:
+                noise: dict[str, float]) -> dict[str, cand.DelayScan]:
     """A delay scan per moved surface; a delay refined beyond the scanned range is not an
     actuator delay, and its column is not offered (it would stand in for another error)."""
     delays = {}
@@ -71,7 +71,7 @@ VANE_NOISE_SHARE = 0.15
 
 
 def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mismatch: dict[str, np.ndarray],
-                        gust=None) -> dict[str, np.ndarray]:
+                       gust=None) -> dict[str, np.ndarray]:
     """The column −C_m,α·e that the α vane's own error passes into C_m's mismatch, e the
     vane's angle less the one the inertial channels integrate to (the kinematic residual's
     vertical "gust" over the airspeed, high-passed at :data:`spectra.GUST_HIGHPASS_HZ`); empty
@@ -107,7 +107,8 @@ def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mism
 
 
 def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str, np.ndarray],
-              mismatch: dict[str, np.ndarray], delays: dict, vane: dict[str, np.ndarray] | None = None) -> StepwiseFits:
+                  mismatch: dict[str, np.ndarray], delays: dict,
+                  vane: dict[str, np.ndarray] | None = None) -> StepwiseFits:
     """Per-axis colored forward selection over the offered candidate terms (and the delay
     columns), with the thrust nuisance where thrust was not recorded and the α vane's noise
     column (:func:`vane_noise_columns`) where the model follows the vane; drift terms that
@@ -244,7 +245,7 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     share = abs(mean) / max(float(np.std(measured["Cm"][inner])), 1e-300)
     z = mismatch["Cm"][inner]
     explained = 1.0 - float(np.mean((z - dx_mean / cbar * measured["CZ"][inner]) ** 2)) / max(float(np.mean(z ** 2)),
-                                                                                           1e-300)
+                                                                                              1e-300)
     if short <= CG_MEAN_SHARE * abs(predicted) or short <= CG_MEAN_Z * mean_se:
         return CgMeanTest(False, "", dx_mean, se_mean, False, share, explained)
     pinned = mean * np.sign(predicted) >= CG_MEAN_Z * mean_se
@@ -265,6 +266,8 @@ def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarra
     if axis not in ("CX", "Cm") or "thrust" in p.raw:
         return {}
     return {"thrust_dV": t.column for t in terms if t.key == "dV"}
+
+
 PROPELLER_DRIFT = ("the propeller's torque, P-factor and slipstream change with airspeed at a fixed throttle, "
                    "outside the model's aerodynamic coefficients: a lateral drift term would fit them")
 NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX or Cm cannot be told from the "
@@ -297,7 +300,7 @@ def _impractical_reason(share: float) -> str:
 
 
 def aero_candidates(selections: dict, delays: dict, dt: float,
-                     shares: dict[tuple[str, str], float] | None = None) -> list[Candidate]:
+                    shares: dict[tuple[str, str], float] | None = None) -> list[Candidate]:
     shares = shares or {}
     out: list[Candidate] = []
     delay_seen: dict[str, list] = {}

@@ -31,7 +31,7 @@ def _refit_term(z: np.ndarray, others: list[np.ndarray], column: np.ndarray) -> 
 
 
 def withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
-                              p: Prepared) -> None:
+                             p: Prepared) -> None:
     """A moment-reference shift is one parameter acting on two axes (C_m through C_Z, C_n
     through C_Y). Once named on one, its share of the other axis's mismatch is known; a term
     selected on that other axis is kept only if it stays significant (|t| >= the entry t)
@@ -67,7 +67,7 @@ def lift_change_on_cx(delta_cz: np.ndarray, alpha: np.ndarray) -> np.ndarray:
 
 
 def withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
-                                p: Prepared) -> None:
+                               p: Prepared) -> None:
     """A named C_Z term may be a change of *lift* (how an aerodynamic table usually carries
     it, and how `models.hidden` conceals a C_Z error), which also puts −ΔC_Z tan α on C_X
     (:func:`lift_change_on_cx`): at α ≈ 8.5° a C_Z,α change of −0.6 leaves a C_X mismatch
@@ -102,7 +102,7 @@ def withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatc
 
 
 def withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: StepwiseFits, p: Prepared, aircraft: Aircraft,
-                                         ic: InitialCondition) -> None:
+                                        ic: InitialCondition) -> None:
     """A drift term on a lateral axis (C ∝ ΔV/V) is judged along the β vane as well.
 
     The inertial sideslip the model follows (:func:`model_states`) is placed on the vane by a
@@ -139,7 +139,7 @@ def withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: StepwiseFi
 
 
 def withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: StepwiseFits, p: Prepared,
-                                                 mismatch: dict[str, np.ndarray]) -> None:
+                                                mismatch: dict[str, np.ndarray]) -> None:
     """A named α² or α³ term must stay significant beside the linear α term when both are
     built on the inertial α (:func:`kinematics.inertial_angles`) rather than the vane's.
 
@@ -185,7 +185,7 @@ def kinematic_bias_of(kin: KinematicResult, channel: str, applied: set[str]) -> 
 
 
 def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
-                     p: Prepared, slope_of, kin: KinematicResult, applied: set[str], V0: float) -> None:
+                    p: Prepared, slope_of, kin: KinematicResult, applied: set[str], V0: float) -> None:
     """Deselect the aerodynamic terms the data cannot tell from a rival (:mod:`rivals`): a
     collinear candidate of the same axis, or a vane bias the kinematics cannot rule out. A
     term that survives keeps its strongest collinear rival in ``details['rival']`` for the
@@ -212,7 +212,7 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                                   "t_rival": rival.t_rival, "coefficient": rival.swapped}
             if abs(rival.t_term) < cand.T_IN:
                 # the identification maneuver cannot tell them apart: a finding only if the
-                # validation maneuver prefers it (run.validation_check), never without one
+                # validation maneuver prefers it (validation.validation_check), never without one
                 c.details["rival"]["indistinct"] = (
                     f"the identification maneuver cannot tell it from {rt.parameter} (columns correlated "
                     f"{rival.correlation:+.2f}; beside it, t = {rival.t_term:.1f})")
@@ -235,6 +235,8 @@ def _bias_text(b: rivals.BiasRival) -> str:
     if not np.isfinite(b.kinematic_std):
         return f"they do not test a {b.channel} bias"
     return f"bias_{b.channel} = {np.degrees(b.kinematic):.2f} ± {np.degrees(b.kinematic_std):.2f} deg"
+
+
 AMBIGUOUS_KINDS = ("scale", "skew", "vane")
 # The instrument each coefficient is measured with (seed Eqs. 1, 3-5): a skew of it imitates
 # an α̇ or rate term of that coefficient (ΔC ≈ −τ dC/dt follows the rates), a scale every term.
@@ -283,7 +285,7 @@ IMITATION_SHARE = 0.5
 
 
 def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
-               mismatch: dict[str, np.ndarray], step: StepwiseFits):
+              mismatch: dict[str, np.ndarray], step: StepwiseFits):
     """``imitated(c, name)``: the largest change of term ``c``'s parameter, in the direction of
     its own change, that sensor error ``name`` imitates anywhere within :data:`IMITATION_Z`
     standard errors of its kinematic estimate; None when it cannot be computed.

@@ -1,0 +1,393 @@
+"""The augmented model: the named effects as model terms and sensor models, the recordings
+replayed before and after (a structural mode notched, turbulence as winds), the calibration
+with JSBSim in the loop, and the augmented JSBSim aircraft written out."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+import pandas as pd
+from scipy import signal
+
+from harness.atomic import write_atomic, write_text_atomic
+from harness.diagnosis import levels, refine
+from harness.diagnosis.along import interior
+from harness.diagnosis.analysis import analyse
+from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.fits import coefficient_fit, output_fit
+from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
+from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
+from harness.diagnosis.validation import after_mismatch
+from harness.executors import LocalPool
+from models.aircraft import Aircraft
+from models.constants import SURFACES
+from models.flight import FlightError
+from models.hidden import HiddenEffect, hidden_root
+from models.replay import initial_condition, replay, steady_start
+from models.trim import TrimError
+
+
+CHANNEL_COLUMNS = {"alpha": "alpha_rad", "beta": "beta_rad", "p": "p_rps", "q": "q_rps", "r": "r_rps",
+                   "phi": "phi_rad", "theta": "theta_rad", "V": "V_fps", "ax": "ax_g", "ay": "ay_g", "az": "az_g"}
+
+
+def _effect_of(c: Candidate) -> HiddenEffect | None:
+    """The model term a finding adds (None for what no deterministic term can add)."""
+    e = c.effect
+    coef = c.channel if c.channel in COEFFICIENTS else "Cm"
+    if e == "unsteady_alphadot":
+        return HiddenEffect(e, c.estimate, coefficient=coef)
+    if e == "nonlinear_alpha":
+        return HiddenEffect(e, c.estimate, coefficient=coef, power=int(c.parameter[-1]))
+    if e == "coefficient_error":
+        return HiddenEffect(e, c.details["change"], coefficient=coef, regressor=c.parameter.split("_", 1)[1])
+    if e == "cross_coupling":
+        return HiddenEffect(e, c.estimate, coefficient=coef, regressor="beta_abs" if c.parameter.endswith("_beta_abs")
+                            else "")
+    if e == "flight_condition_drift":
+        return HiddenEffect(e, c.estimate, coefficient=coef)
+    if e == "cg_offset":
+        return HiddenEffect(e, c.estimate)
+    if e == "control_delay":
+        return HiddenEffect(e, max(c.estimate, 0.0), surface=c.channel)
+    if e == "sensor_offset" and c.channel == "accelerometer":
+        if "position_ft" in c.details:  # the force-mismatch fit: the whole vector
+            pos = tuple(float(v) for v in c.details["position_ft"])
+        else:  # the kinematic check: one component (offset_x, offset_y, offset_z)
+            pos = tuple(float(c.estimate) if c.parameter == f"offset_{a}" else 0.0 for a in "xyz")
+        return HiddenEffect(e, pos[0], position_ft=pos)
+    if e in ("sensor_bias", "sensor_scale", "sensor_time_skew"):
+        channel = c.channel if c.channel in CHANNEL_COLUMNS else c.parameter.split("_", 1)[1]
+        if channel in CHANNEL_COLUMNS:
+            return HiddenEffect(e, c.estimate, channel=channel)
+    return None
+
+
+def terms_of(findings: list[Candidate], applied: dict[str, float]) -> tuple[HiddenEffect, ...]:
+    """The model terms the findings add. A scale factor is estimated together with its
+    channel's bias (the kinematic fit always carries the bias); when that bias was applied to
+    the channels but is too small to be a finding itself, the scale's sensor model carries it
+    too (the recorded angle is (1 + k)·x + b, not (1 + k)·x)."""
+    out = []
+    for f in findings:
+        e = _effect_of(f)
+        if e is None:
+            continue
+        out.append(e)
+        bias = f"bias_{e.channel}"
+        if e.effect == "sensor_scale" and bias in applied and not any(g.parameter == bias for g in findings) \
+                and "offset" not in f.details:  # a scale read from the bias carries it (scale_read_as_bias)
+            out.append(HiddenEffect("sensor_bias", float(applied[bias]), channel=e.channel))
+    return tuple(out)
+
+
+def _sim_channels(hist) -> dict[str, np.ndarray]:
+    return {c: hist.channels[col] for c, col in CHANNEL_COLUMNS.items()}
+
+
+def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
+    """The initial condition with the found sensor errors of V, α and h undone (recorded =
+    x + b, (1 + k)·x): the augmented model must start where the aircraft was, not where
+    its instruments said it was."""
+    ch = {c: p.smooth[c].copy() for c in ("V", "alpha") if c in p.smooth}
+    if p.altitude is not None:
+        ch["h"] = p.altitude.copy()
+    for e in added:
+        if e.channel in ch and e.effect == "sensor_bias":
+            ch[e.channel] = ch[e.channel] - e.size
+        elif e.channel in ch and e.effect == "sensor_scale":
+            ch[e.channel] = ch[e.channel] / (1.0 + e.size)
+    return initial_condition(p.t, ch["V"], ch["alpha"], ch.get("h"))
+
+
+def _replay_surfaces(p: Prepared) -> dict[str, np.ndarray]:
+    """The smoothed surfaces the replay is driven by, each starting at its raw start level
+    (:func:`models.replay.steady_start`): the smoothed first sample carries the filter's end
+    effects and the noise, which the replay would hold as a constant deflection."""
+    return {s: steady_start(p.smooth[s], p.t, level_of=p.raw[s]) for s in SURFACES if s in p.smooth}
+
+
+class Replayed(NamedTuple):
+    """One replay of a maneuver: its outputs by quantity (None when it could not be flown),
+    the surface-level offsets fitted (:mod:`harness.diagnosis.levels`, rad) and why it failed."""
+
+    outputs: dict[str, np.ndarray] | None
+    levels: dict[str, float]
+    failed: str | None = None
+
+
+def _fitted_replay(p: Prepared, fly) -> Replayed:
+    """``fly`` (surfaces -> history) over ``p``'s surfaces with their levels fitted
+    (:func:`levels.fit_levels`); a trim or flight error is reported, not raised."""
+    surfaces = _replay_surfaces(p)
+    bounds = {s: levels.level_bound(p.smooth[s], p.noise_std.get(s, 0.0), p.t) for s in surfaces}
+    floors = {c: max(p.noise_std.get(c, 0.0), 1e-9) for c in OUTPUTS if c in p.smooth}
+    try:
+        fit = levels.fit_levels(lambda surf: _sim_channels(fly(surf)), surfaces, bounds, p.smooth, floors, interior(p))
+    except (FlightError, TrimError) as exc:  # reported, not fatal: the coefficient analysis still stands
+        return Replayed(None, {}, str(exc))
+    return Replayed(fit.outputs, fit.offsets)
+
+
+def analysed(rec, role: str, aircraft: Aircraft) -> tuple[Prepared, Analysis, Replayed]:
+    """One maneuver prepared, analysed and replayed as the model is (a unit of work a second
+    process can take)."""
+    p = prepare(rec, role)
+    a = analyse(p, aircraft, initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude))
+    return p, a, replay_before(p, aircraft, a)
+
+
+def replay_before(p: Prepared, aircraft: Aircraft, analysis: Analysis) -> Replayed:
+    """The model as given, replayed over one maneuver."""
+    return _fitted_replay(p, lambda surf: replay(aircraft, analysis.ic, p.t, surf)[0])
+
+
+def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect, ...],
+                      findings: list[Candidate] | None, analysis: Analysis, before: Replayed | None = None,
+                      refs: dict | None = None):
+    """Replays before/after and fits for one analysed maneuver; on the validation maneuver
+    the identification's findings are applied as predictions. ``before`` reuses an earlier
+    :func:`replay_before` of the same maneuver; ``refs`` are the trim references of the added
+    terms (default: the nominal model's trim at the maneuver's start, :func:`models.hidden.hidden_root`).
+    Each replay fits its own surface levels (:mod:`harness.diagnosis.levels`)."""
+    before = before if before is not None else replay_before(p, aircraft, analysis)
+    after = before
+    winds = _turbulence_winds(p, analysis) if any(f.effect == "turbulence" for f in findings or []) else None
+    if (added or winds is not None) and before.failed is None:
+        augmented, start = Aircraft(aircraft.model, hidden=added), _true_start(p, added)
+        after = _fitted_replay(p, lambda surf: replay(augmented, start, p.t, surf, wind_ned_fps=winds, refs=refs)[0])
+    before_failed, diverged = before.failed, after.failed
+    a = analysis
+    before_mm = a.mismatch
+    after_mm, n_terms = after_mismatch(a, findings or [])
+    inner = interior(p)
+    nan = {c: np.full(p.n, np.nan) for c in CHANNEL_COLUMNS}
+    sim_b = before.outputs if before.outputs is not None else nan
+    sim_a = after.outputs if after.outputs is not None else nan
+    fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner) if before_failed is None else {},
+             "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
+    raw_after = _mode_notched(p, findings or [])
+    fit_a = {"outputs": output_fit(p.smooth, raw_after, sim_a, OUTPUTS, inner) if diverged is None else {},
+             "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
+    fit_b["surface_levels_deg"] = {k: float(np.degrees(v)) for k, v in before.levels.items()}
+    fit_a["surface_levels_deg"] = {k: float(np.degrees(v)) for k, v in after.levels.items()}
+    if before_failed is not None:
+        fit_b["replay_failed"] = f"the model could not replay this maneuver: {before_failed}"
+        fit_a["replay_failed"] = fit_b["replay_failed"]
+    elif diverged is not None:
+        fit_a["replay_failed"] = f"the augmented model could not replay this maneuver: {diverged}"
+    series = {"t_s": p.t}
+    for c in OUTPUTS:
+        if c in p.raw:
+            series[f"meas_{c}"] = p.raw[c]
+            series[f"smooth_{c}"] = p.smooth[c]
+            series[f"before_{c}"] = sim_b[c]
+            series[f"after_{c}"] = sim_a[c]
+    for c in COEFFICIENTS:
+        series[f"coef_meas_{c}"] = a.mismatch[c] + a.aero.coefficients[c]
+        series[f"coef_model_{c}"] = a.aero.coefficients[c]
+        series[f"coef_after_{c}"] = a.aero.coefficients[c] + (a.mismatch[c] - after_mm[c])
+    for s in SURFACES:
+        if s in p.raw:
+            series[s] = p.raw[s]
+    return a, fit_b, fit_a, pd.DataFrame(series)
+
+
+# Quality factor of the sensor model's notch for a structural mode (bandwidth f0/Q): wide
+# enough for the mode's frequency uncertainty (a 2 s Welch segment resolves 0.5 Hz).
+MODE_NOTCH_Q = 8.0
+
+
+def _mode_notched(p: Prepared, findings: list[Candidate]) -> dict[str, np.ndarray]:
+    """The recorded channels as the augmented sensor model sees them: a structural mode found
+    becomes a notch (scipy.signal.iirnotch at its frequency, zero phase) in every rate and
+    acceleration channel, so the raw fit after shows what the mode term removes. Returns
+    ``p.raw`` unchanged when no mode was found."""
+    modes = [f for f in findings if f.effect == "structural_mode"]
+    if not modes:
+        return p.raw
+    out = dict(p.raw)
+    fs = 1.0 / p.dt
+    for f in modes:
+        if not 0.0 < f.estimate < 0.5 * fs:
+            continue
+        b, a = signal.iirnotch(f.estimate, MODE_NOTCH_Q, fs=fs)
+        for c in MODE_CHANNELS:
+            if c in out:
+                out[c] = signal.filtfilt(b, a, out[c])
+    return out
+
+
+def _turbulence_winds(p: Prepared, a: Analysis) -> dict[str, np.ndarray] | None:
+    """The gusts this maneuver met, as a north-east-down wind for the replay: the body-axis
+    gust histories the kinematic residuals give (:func:`spectra.gust_estimate`) rotated by
+    the recorded attitude. A deterministic stand-in for a process-noise model: the augmented
+    replay flies through the turbulence each maneuver's own kinematics reconstruct."""
+    if a.gust is None or getattr(a.gust, "w_fps", None) is None:
+        return None
+    psi = p.smooth.get("psi", np.zeros(p.n))
+    return gust_wind_ned(a.gust, p.smooth["phi"], p.smooth["theta"], psi)
+
+
+def fly_all(maneuvers: dict, aircraft: Aircraft, added: tuple[HiddenEffect, ...], modelled: list[Candidate],
+            befores: dict, refs: dict | None = None, pool: LocalPool | None = None) -> dict:
+    """:func:`fly_maneuver_pair` for each role of ``maneuvers`` (role -> (prepared, analysis)), the
+    model as given flown once (``befores``): role -> (analysis, fit before, fit after, series).
+    With a ``pool``, the validation maneuver is flown in its process meanwhile."""
+    pending = {role: pool.pool.submit(fly_maneuver_pair, pm, aircraft, added, modelled, am, befores[role], refs)
+               for role, (pm, am) in maneuvers.items() if pool is not None and role == "validation"}
+    out = {role: fly_maneuver_pair(pm, aircraft, added, modelled, am, befores[role], refs)
+           for role, (pm, am) in maneuvers.items() if role not in pending}
+    return out | {role: fut.result() for role, fut in pending.items()}
+
+
+def refine_in_the_loop(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int, maneuvers: dict,
+                       befores: dict, modelled: list[Candidate], added: tuple[HiddenEffect, ...], flown: dict,
+                       pool: LocalPool | None = None):
+    """The last step: calibrate the kept aircraft terms in the loop and keep the calibrated sizes
+    only when they fit at least as well (:func:`refine.decide`).
+
+    Returns
+    -------
+    (block, modelled, added, flown)
+        findings.json's ``calibration`` block, and the findings, terms and flights to report:
+        the calibrated ones when used, else those given.
+    """
+    from harness.calibrate import CalibrationError
+    from harness.calibrate import calibrate as calibrate_in_loop
+    pairs = refine.calibratable([(f, _effect_of(f)) for f in modelled])
+    if not pairs:
+        return ({"used": False, "reason": "no aerodynamic or delay term was added: nothing to calibrate"},
+                modelled, added, flown)
+    terms = [e for _, e in pairs]
+    hold, hold_reason = refine.surface_hold(recs["identification"].meta)
+    matched = refine.matched_outputs(terms, recs["identification"])
+    block = {"used": False, "hold": hold, "hold_assumption": hold_reason, "workers": workers,
+             "matched_outputs": list(matched)}
+    try:
+        cal = calibrate_in_loop(model, [recs["identification"]], refine.parameter_spec(terms),
+                                validation=[recs["validation"]] if "validation" in recs else None, workers=workers,
+                                mass=mass, hold=hold, outputs=matched)
+    except (CalibrationError, FlightError, TrimError, RuntimeError, ValueError, OSError) as exc:
+        # the last step never takes the diagnosis down: the equation-error sizes stand
+        return block | {"reason": f"the calibration could not run: {type(exc).__name__}: {exc}"}, modelled, added, flown
+    sizes = {a.name: float(v) for a, v in zip(cal.adjustments, cal.estimate)}
+    refined = refine.refined_findings(pairs, sizes, dict(zip((a.name for a in cal.adjustments), cal.std_error)))
+    modelled_cal = [refined[id(f)][0] if id(f) in refined else f for f in modelled]
+    added_cal = refine.refined_terms(added, sizes)
+    # the calibrated sizes belong to the calibration's term references (its unadjusted model's
+    # trim at the recording's start): the augmented model is flown and written with them
+    flown_cal = fly_all(maneuvers, aircraft, added_cal, modelled_cal, befores, dict(cal.refs), pool)
+    fits_ee = {r: v[2] for r, v in flown.items()}
+    fits_cal = {r: v[2] for r, v in flown_cal.items()}
+    used, reason, figures = refine.decide(cal, fits_ee, fits_cal, refine.affected_outputs(terms))
+    block |= {"used": used, "reason": reason, **refine.calibration_detail(cal, terms, fits_ee, fits_cal), **figures,
+              "findings": {f.parameter: refined[id(f)][1] for f in modelled if id(f) in refined}}
+    if used:
+        return block, modelled_cal, added_cal, flown_cal
+    return block, modelled, added, flown
+
+
+# A named aircraft term is withdrawn when the calibration (output error, JSBSim in the loop,
+# used because it fits at least as well) sizes it within this many of its standard errors of
+# no change. Measured on 2 Dec 2026 over both sweeps and the DHC-6 cases: every true finding
+# the calibration refined stood at |z| >= 10; the one it did not support, a C_l,αβ
+# the noise-free DHC-6 self-check drew from the propeller torque's change with airspeed
+# (equation error -1.66 ± 0.29 per rad^2), at z = -1.1.
+CALIBRATED_MIN_Z = 3.0
+
+
+def unsupported_in_the_loop(findings: list[Candidate], calibration: dict, checks: dict) -> list[Candidate]:
+    """The findings the calibration, when used, sizes within :data:`CALIBRATED_MIN_Z` standard
+    errors of no change; their ``checks`` entry says so (status 'unsupported')."""
+    if not calibration.get("used"):
+        return []
+    sized = calibration.get("findings") or {}
+    out = []
+    for f in findings:
+        own = sized.get(f.parameter)
+        if not own or not own.get("std_error") or abs(own["size"]) >= CALIBRATED_MIN_Z * own["std_error"]:
+            continue
+        before = checks.get(id(f)) or {}
+        checks[id(f)] = {**before, "status": "unsupported", "validation_status": before.get("status", "not checked"),
+                         "reason": (f"the calibration (output error, JSBSim in the loop) sizes it "
+                                    f"{own['size']:.3g} ± {own['std_error']:.2g}, within {CALIBRATED_MIN_Z:g} standard "
+                                    f"errors of no change (equation error: {f.details.get('change', f.estimate):.3g}"
+                                    f" ± {f.std_error:.2g}): the "
+                                    "mismatch it fitted is not one the augmented model flies")}
+        out.append(f)
+    return out
+
+
+def with_calibration(d: dict, calibration: dict) -> dict:
+    """A finding's dict with its calibrated size and standard error (``calibrated``: the size in
+    the model when the calibration was used, else only reported), and a sentence in the
+    explanation. When used, the calibrated size is the finding's ``estimate`` and
+    ``std_error`` (and a coefficient error's ``change``): the equation-error ones move to
+    ``equation_error``, their fits to ``fit_after_equation_error``."""
+    own = (calibration.get("findings") or {}).get(d["parameter"])
+    if own is None:
+        return d
+    d["calibrated"] = own | {"used": bool(calibration["used"])}
+    if calibration["used"]:
+        # the headline is the size the augmented model flies with; the equation-error one stays beside it
+        d["equation_error"] = {"estimate": d["estimate"], "std_error": d["std_error"]}
+        d["estimate"], d["std_error"] = float(own["estimate"]), float(own["std_error"])
+        if "change" in d["evidence"]:
+            d["equation_error"]["change"] = d["evidence"]["change"]
+            d["evidence"]["change"] = float(own["size"])
+        d["fit_after_equation_error"] = calibration["fit_after_equation_error"]
+        d["explanation"] += (f" Refined with JSBSim in the loop: {own['estimate']:.4g} ± {own['std_error']:.2g}, the "
+                             "size the augmented model flies with.")
+    else:
+        d["explanation"] += (f" Calibrated with JSBSim in the loop it would be {own['estimate']:.4g} ± "
+                             f"{own['std_error']:.2g}; the equation-error size is kept ({calibration['reason']}).")
+    return d
+
+
+def calibration_assumptions(calibration: dict) -> list[dict]:
+    """The calibration step's assumption (how its replay holds the recorded surfaces)."""
+    if "hold" not in calibration:
+        return []
+    return [{"item": "surfaces between samples (calibration)", "missing": "-",
+             "stood_in_by": f"{calibration['hold']}: {calibration['hold_assumption']}"}]
+
+
+def sensor_models(findings: list[Candidate]) -> list[dict]:
+    """Findings that become sensor- or atmosphere-side models rather than aircraft terms: a
+    structural mode's notch and the turbulence's reconstructed gusts."""
+    out = []
+    for f in findings:
+        if f.effect == "structural_mode":
+            out.append({"effect": "structural_mode", "frequency_hz": float(f.estimate), "notch_q": MODE_NOTCH_Q,
+                        "channels": [c for c in MODE_CHANNELS], "model": "second-order notch (scipy.signal.iirnotch), "
+                        "zero phase, on the rate and acceleration channels"})
+        if f.effect == "turbulence":
+            out.append({"effect": "turbulence", "sigma_gust_fps": float(f.estimate),
+                        "model": "the replay flies through the gusts each maneuver's kinematic residuals reconstruct "
+                                 "(u, v, w integrated and high-passed at 0.05 Hz, rotated to north-east-down)"})
+    return out
+
+
+def write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ...],
+                other: list[dict] | None = None, refs: dict | None = None) -> dict:
+    """Copy the augmented aircraft (XML) into ``out/model``; sensor effects (and a structural
+    mode's notch, the turbulence model) are listed in ``sensors.json`` beside it (they change
+    what the instruments record, or the air the aircraft flies through, not the aircraft)."""
+    dest = out / "model"
+    dest.mkdir(parents=True, exist_ok=True)
+    terms = [e.describe() | {"parameter": e.parameter} for e in added]
+    sensors = [t for t, e in zip(terms, added) if e.effect.startswith("sensor_")] + list(other or [])
+    write_text_atomic(dest / "sensors.json", json.dumps(sensors, indent=1))
+    if not any(not e.effect.startswith("sensor_") for e in added):
+        return {"base": aircraft.model, "augmented_xml": None, "terms": terms,
+                "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
+    root, name = hidden_root(Aircraft(aircraft.model, hidden=added), ic.condition(), refs)
+    src = root / "aircraft" / name / f"{name}.xml"
+    target = dest / f"{aircraft.name}-diagnosed.xml"
+    write_atomic(target, lambda fh: fh.write(src.read_bytes()))
+    return {"base": aircraft.model, "augmented_xml": str(target.relative_to(out)), "terms": terms,
+            "note": ("a control delay is a property (sidbench/<surface>-delay-delta-rad) the sidbench flight loop "
+                     "drives; the aerodynamic terms fly in any JSBSim")}

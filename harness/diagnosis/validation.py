@@ -1,0 +1,303 @@
+"""Each finding tested on the validation maneuver: applied at its identified size to that
+maneuver's coefficient mismatch (a prediction, nothing refitted), a rival that fits as well,
+a coupling the maneuver does not excite, and the same sensor's verdict there."""
+from __future__ import annotations
+
+import numpy as np
+
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import interior
+from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared
+from harness.diagnosis.sensor_naming import MEANS_TESTS
+
+
+def after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """The coefficient mismatch once the aerodynamic findings' terms are added (their
+    estimated sizes, not refitted: on a validation maneuver this is a prediction)."""
+    p = a.prepared
+    after = {c: v.copy() for c, v in a.mismatch.items()}
+    n_terms = {c: 0 for c in COEFFICIENTS}
+    measured = {c: a.mismatch[c] + a.aero.coefficients[c] for c in COEFFICIENTS}
+    for f in findings:
+        if f.effect == "control_delay":
+            s = f.channel
+            for c in cand.SURFACE_AXES[s]:
+                d = a.aero.derivatives.get(f"{c}_{s}", 0.0)
+                if d:
+                    x = p.smooth[s]
+                    after[c] = after[c] - d * (np.interp(p.t - f.estimate, p.t, x) - x)
+                    n_terms[c] += 1
+            continue
+        if f.channel not in COEFFICIENTS:
+            continue
+        terms = {t.parameter if t.effect != "coefficient_error" else t.parameter: t
+                 for t in cand.library(p, f.channel, a.aero.derivatives, measured, a.aero.coefficients)}
+        term = terms.get(f.parameter)
+        if term is None:
+            continue
+        coef = f.details.get("change", f.estimate / term.scale)
+        after[f.channel] = after[f.channel] - coef * term.column
+        n_terms[f.channel] += 1
+    return after, n_terms
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean((x - x.mean()) ** 2)))
+
+
+def validation_check(av: Analysis, f: Candidate) -> dict | None:
+    """What one identification finding, with its size as estimated, does to the validation
+    maneuver's coefficient mismatch on its axes (a prediction: nothing is refitted).
+
+    ``status`` is 'confirmed' (the mismatch RMS, summed over its axes in units of each axis's
+    noise level, drops by 1 % or more), 'contradicted' (it rises by 1 % or more) or 'neutral';
+    None for a finding with no coefficient term (a sensor effect, a gust level, a spectral
+    peak)."""
+    if f.test in MEANS_TESTS.values():
+        return _vane_means_check(av, f)
+    if f.test.startswith("kinematic consistency") or f.parameter == "x_accelerometer":
+        return _sensor_check(av, f)
+    after, n_terms = after_mismatch(av, [f])
+    axes = [c for c in COEFFICIENTS if n_terms[c]]
+    if not axes:
+        return None
+    why = untestable(av.prepared, f)
+    if why:
+        return {"status": "untested", "axes": axes, "reason": why}
+    inner = interior(av.prepared)
+    before_rms = {c: _rms(av.mismatch[c][inner]) for c in axes}
+    after_rms = {c: _rms(after[c][inner]) for c in axes}
+    w = _noise_weights(av, axes)
+    ratio = sum(w[c] * after_rms[c] for c in axes) / max(sum(w[c] * before_rms[c] for c in axes), 1e-300)
+    status = "confirmed" if ratio <= 0.99 else ("contradicted" if ratio >= 1.01 else "neutral")
+    out = {"status": status, "axes": axes, "rms_before": before_rms, "rms_after": after_rms, "change": ratio - 1.0}
+    rival = _rival_check(av, f, axes, {c: after[c][inner] for c in axes}, ratio - 1.0)
+    if rival is not None:
+        out["rival"] = rival
+        if status == "confirmed" and rival["fits_as_well"]:
+            out["status"] = "ambiguous"
+            out["reason"] = _ambiguous_reason(rival, ratio - 1.0)
+        elif rival["indistinct"]:
+            out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
+    return out
+
+
+def untestable(pv: Prepared, f: Candidate) -> str:
+    """Why the validation maneuver ``pv`` cannot test aerodynamic finding ``f`` ('' when it
+    can): it drove each of the term's states, but not as the term needs (an α·β coupling
+    where α and β never moved together, :func:`candidates.offered`). Predicted there, the
+    term's column is its regressors' noise, and the validation RMS would judge the noise,
+    not the term: a C_l α·β of −2 named at t −22 with the stabilator and rudder moved
+    together was 'contradicted' (+13 %) by a sequential validation maneuver along the α
+    vane's wander. Such a finding stands on the identification maneuver alone, as without a
+    validation maneuver, and says so.
+
+    A term on a state the validation maneuver did not drive at all is tested as before (and
+    left unconfirmed by the noise it meets): the two maneuvers are then of different kinds, and
+    the identification's own drive of that state may be incidental (on a lateral maneuver at
+    25,000 ft / 500 ft/s a C_Z,α entered at t 5.5 where α moved with the lateral motion;
+    passed untested, only the calibration in the loop withdrew it)."""
+    if f.channel not in COEFFICIENTS:
+        return ""
+    measured = {c: np.zeros(pv.n) for c in COEFFICIENTS}
+    term = next((t for t in cand.library(pv, f.channel, {}, measured) if t.parameter == f.parameter), None)
+    if term is None or not set(term.sources) <= set(pv.driven):
+        return ""
+    _, skipped = cand.offered(pv, [term])
+    if not skipped:
+        return ""
+    return f"the validation maneuver does not excite {f.parameter} ({skipped[0].details.get('not_offered', '')})"
+
+
+def _ambiguous_reason(rival: dict, change: float) -> str:
+    """Why a confirmed finding is left ``ambiguous`` by its rival (:func:`rival_fits_as_well`)."""
+    m = 100 * rival["margin"]
+    rms = f"RMS {rival['noise_levels_rival']:.3g} against {rival['noise_levels_own']:.3g} noise levels"
+    if rival["indistinct"]:
+        why = f"{rms}, a difference under {m:.0f} %, two standard errors of an RMS of this record"
+    elif change <= -rival["margin"]:
+        why = f"{rms}: better by more than {m:.0f} %, two standard errors of an RMS of this record"
+    else:
+        why = (f"{rms}; the finding itself lowers the validation RMS by {100 * -change:.0f} %, under the "
+               f"{m:.0f} % that two standard errors of an RMS of this record allow")
+    return (f"the validation maneuver is fitted about as well by {rival['parameter']} (its rival in the "
+            f"identification fit: columns correlated {rival['correlation']:+.2f}; {why})")
+
+
+def undecided(f: Candidate) -> dict | None:
+    """Without a validation maneuver: a finding the identification maneuver cannot tell from
+    its rival is 'ambiguous' (not a finding); the others are not checked (None)."""
+    why = (f.details.get("rival") or {}).get("indistinct")
+    return {"status": "ambiguous", "reason": f"{why}; no validation maneuver to decide"} if why else None
+
+
+def rms_margin(residual: np.ndarray, z: float = 2.0) -> float:
+    """``z`` relative standard errors of an RMS estimated from a colored record: 1/√(2 n_eff),
+    with n_eff = N (1 − ρ₁)/(1 + ρ₁) from the lag-one autocorrelation ρ₁ (Bartlett's
+    first-order approximation for an AR(1) record)."""
+    r = residual - residual.mean()
+    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(float(np.dot(r, r)), 1e-300), -0.99, 0.99))
+    n_eff = max(r.size * (1.0 - rho) / (1.0 + rho), 2.0)
+    return z / np.sqrt(2.0 * n_eff)
+
+
+def rival_fits_as_well(own: float, theirs: float, margin: float, indistinct: bool, change: float) -> bool:
+    """Whether a finding's collinear rival predicts the validation maneuver as well as the
+    finding does, so that the finding is left ``ambiguous``.
+
+    Parameters
+    ----------
+    own, theirs : validation RMS of the mismatch with the finding's term, and with its rival's
+        in its place (each sized as fitted alone on the identification maneuver), in noise levels.
+    margin : two relative standard errors of the finding's validation RMS (:func:`rms_margin`).
+    indistinct : the identification maneuver could not tell the two apart (the term's |t|
+        beside its rival under the entry t).
+    change : the finding's own relative change of the validation RMS (negative: a drop).
+
+    A preference within the validation record's sampling error is no preference, so the
+    burden follows the identification maneuver's verdict: a rival it could not set apart
+    must do worse by more than ``margin`` for the finding to stand; one it did set apart
+    overturns the finding only by doing better by more than ``margin`` -- when the validation
+    maneuver supports the finding itself by more than ``margin``. Where the finding does not
+    lower the validation RMS by that much, the validation maneuver has no verdict of its own
+    on it and any preference for the rival leaves it ambiguous."""
+    if indistinct:
+        return theirs <= own * (1.0 + margin)
+    if change <= -margin:
+        return theirs <= own * (1.0 - margin)
+    return theirs <= own
+
+
+def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, np.ndarray],
+                 change: float) -> dict | None:
+    """The finding's strongest collinear rival (``details['rival']``, :mod:`rivals`), sized
+    as fitted in its place on the identification maneuver, predicting the same validation
+    axes; ``fits_as_well`` by :func:`rival_fits_as_well`."""
+    r = f.details.get("rival")
+    if not r:
+        return None
+    twin = Candidate(r["effect"], f.axis, r["axis"], r["parameter"], 0.0, 0.0, r["t_rival"], 0.0, "", f.test,
+                     details={"change": r["coefficient"]})
+    rival_after, _ = after_mismatch(av, [twin])
+    inner = interior(av.prepared)
+    rival_rms = {c: _rms(rival_after[c][inner]) for c in axes}
+    # summed over the axes in units of each axis's noise level, as validation_check does
+    w = _noise_weights(av, axes)
+    own = sum(w[c] * _rms(after[c]) for c in axes)
+    theirs = sum(w[c] * rival_rms[c] for c in axes)
+    margin = max(rms_margin(after[c]) for c in axes)
+    indistinct = r.get("indistinct", "")
+    return {"parameter": r["parameter"], "correlation": r["correlation"], "rms_after": rival_rms, "margin": margin,
+            "noise_levels_own": own, "noise_levels_rival": theirs,
+            "fits_as_well": rival_fits_as_well(own, theirs, margin, bool(indistinct), change),
+            "indistinct": indistinct}
+
+
+def _noise_weights(av: Analysis, axes: list[str]) -> dict[str, float]:
+    """Each axis in units of its own noise level: summed raw, C_Y's mismatch (a_y noise)
+    would outweigh a C_l or C_n change ten times smaller in coefficient units but larger in
+    noise."""
+    return {c: 1.0 / max(av.noise.get(c, 1.0), 1e-300) for c in axes}
+
+
+# The |t| the same sensor parameter must reach, with the same sign, on the validation
+# maneuver for a sensor finding to be kept (the same instrument flew both maneuvers).
+SENSOR_CONFIRM_T = 3.0
+# For a sensor finding named on two tests (kinematics below their entry t, and the coefficient
+# mismatch; :mod:`harness.diagnosis.corroborate`), the validation maneuver's kinematic estimate
+# need reach only this |t| when it agrees with the identification's within two standard errors.
+CORROBORATED_CONFIRM_T = 2.0
+
+
+def _sensor_check(av: Analysis, f: Candidate) -> dict:
+    """A sensor finding tested on the validation maneuver: the instrument is the same, so its
+    parameter, estimated there by the same kinematic check, must show with the same sign and
+    |t| >= :data:`SENSOR_CONFIRM_T` ('confirmed'); of the opposite sign at that |t|,
+    'contradicted'; else 'neutral'."""
+    if "replication" in f.details:  # named on the two maneuvers' kinematics together
+        v, sv = f.details["replication"]["validation"]
+        return {"status": "confirmed", "axes": [], "estimate": float(v), "std_error": float(sv), "t": float(v / sv),
+                "rule": "named on both maneuvers' kinematics (sensor_naming.name_replicated)"}
+    twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
+    if twin is None:
+        return {"status": "neutral", "axes": [], "estimate": None, "t": None,
+                "reason": "the validation maneuver does not test this parameter"}
+    same = np.sign(twin.estimate) == np.sign(f.estimate)
+    status = _same_instrument_status(twin.estimate, twin.t, f.estimate)
+    out = {"status": status, "axes": [], "estimate": float(twin.estimate), "std_error": float(twin.std_error),
+           "t": float(twin.t)}
+    if status == "neutral" and "offset" in f.details and "offset" not in twin.details:
+        out = _offset_scale_check(av, f, twin) or out
+        status = out["status"]
+    kin = f.details.get("corroboration") or {}
+    if status == "neutral" and kin.get("named") and same and abs(twin.t) >= CORROBORATED_CONFIRM_T:
+        # named on two tests, each below the kinematic entry alone: the validation maneuver's
+        # kinematic estimate must agree with the identification's, at a lower |t|
+        apart = abs(twin.estimate - kin["kinematic"])
+        if apart <= 2.0 * np.hypot(twin.std_error, kin["kinematic_std"]):
+            out |= {"status": "confirmed", "rule": f"corroborated finding: same sign, |t| >= "
+                    f"{CORROBORATED_CONFIRM_T:g} and within two standard errors of the identification's kinematic "
+                    f"estimate ({kin['kinematic']:.4g} ± {kin['kinematic_std']:.2g})"}
+    return out
+
+
+def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | None:
+    """A scale factor named on its offset and its excursions together
+    (:func:`sensor_rules.scale_read_as_bias`), tested the same way on the validation maneuver:
+    there too the offset at the mean (its bias read as k = b/x̄_true) and the excursions
+    (the kinematic k, ``twin``) must agree within two standard errors; their
+    inverse-variance mean is then the validation maneuver's estimate, judged as any sensor
+    finding's (:func:`_same_instrument_status`). None when they disagree or there is no
+    offset reading. (An F-16 at 22,000 ft and 600 ft/s with a 10 % α-vane scale: named at
+    0.101 ± 0.007; the validation maneuver's excursions alone gave 0.048 ± 0.036, t 1.3,
+    its offset 0.12 ± 0.013.)"""
+    channel = f.parameter.split("_", 1)[1]
+    reading = next((c.details["as_scale"] for c in av.candidates
+                    if c.parameter == f"bias_{channel}" and "as_scale" in c.details), None)
+    if reading is None or not twin.std_error > 0:
+        return None
+    k_off, se_off = reading["k"], reading["k_std"]
+    if abs(k_off - twin.estimate) > 2.0 * np.hypot(se_off, twin.std_error):
+        return None
+    w = np.array([1.0 / se_off ** 2, 1.0 / twin.std_error ** 2])
+    k = float(np.dot(w, [k_off, twin.estimate]) / w.sum())
+    se = float(1.0 / np.sqrt(w.sum()))
+    return {"status": _same_instrument_status(k, k / se, f.estimate), "axes": [], "estimate": k, "std_error": se,
+            "t": k / se, "rule": f"the offset at the mean {channel} (k = {k_off:.3f} ± {se_off:.3f}) and the "
+            f"excursions (k = {twin.estimate:.3f} ± {twin.std_error:.3f}) agree"}
+
+
+def _vane_means_check(av: Analysis, f: Candidate) -> dict:
+    """A vane bias named on the coefficient means (:func:`sensor_naming.name_vane_bias_from_means`),
+    tested the same way on the validation maneuver: the same vane, so the same sign at
+    |t| >= :data:`SENSOR_CONFIRM_T` there ('confirmed'), the opposite sign at that |t|
+    ('contradicted'), else 'neutral'. Where the validation maneuver's kinematics gave the bias
+    themselves (its means test is then not run), their estimate is the verdict
+    (:func:`_sensor_check`), unless they also name a scale or skew of that vane: a scale
+    factor reads as a bias at the trim α (8 % of 5.3° is 0.42°), and is then the likelier."""
+    twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
+    means = (twin.details.get("vane_means") if twin is not None else None) or {}
+    channel = f.parameter.split("_", 1)[1]
+    # a scale (or skew) of the vane named there would explain the same offset at trim α
+    rival = next((c.parameter for c in av.candidates if c.selected and c.parameter in
+                  (f"scale_{channel}", f"skew_{channel}")), None)
+    if not means:
+        if rival is None and twin is not None and twin.test.startswith("kinematic consistency"):
+            return _sensor_check(av, f) | {"rule": "the validation maneuver's kinematics gave this vane bias"}
+        why = (f"the validation maneuver's kinematics name {rival}, which at trim reads as this bias" if rival else
+               "the validation maneuver's coefficient means cannot tell this vane bias")
+        return {"status": "neutral", "axes": [], "estimate": None, "t": None, "reason": why}
+    v, sv = means["estimate"], means["std_error"]
+    t = v / sv if sv > 0 else 0.0
+    return {"status": _same_instrument_status(v, t, f.estimate), "axes": list(means["axes"]), "estimate": float(v),
+            "std_error": float(sv), "t": float(t)}
+
+
+def _same_instrument_status(there: float, t_there: float, here: float) -> str:
+    """The validation maneuver's verdict on a sensor finding of size ``here``: the same test
+    there gave ``there`` at ``t_there``; the same sign at |t| >= :data:`SENSOR_CONFIRM_T` is
+    'confirmed', the opposite sign at that |t| 'contradicted', anything else 'neutral'."""
+    if abs(t_there) < SENSOR_CONFIRM_T:
+        return "neutral"
+    return "confirmed" if np.sign(there) == np.sign(here) else "contradicted"

@@ -1,0 +1,368 @@
+"""The diagnosis's words: each finding's explanation and evidence, the located paragraph,
+what the recording could not check and what was assumed, and a model that cannot
+represent the recording refused (:class:`DiagnosisError`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import interior
+from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.gust_rules import vane_wander
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, undriven_reason
+from harness.diagnosis.sensor_naming import MEANS_TESTS
+from models.aircraft import Aircraft
+from models.constants import SURFACES
+
+
+EXPLAIN = {
+    "unsteady_alphadot": "The {axis} mismatch follows the angle-of-attack rate: the model lacks an unsteady "
+                         "(downwash-lag) term, estimated as {parameter} = {estimate:.3g} ± {std_error:.2g} {units}.",
+    "control_delay": "The model responds to {channel} too early: the surface acts about {estimate:.3f} ± "
+                     "{std_error:.3f} s after the recorded position (an actuator delay the model lacks).",
+    "sensor_offset": "The accelerometer is not at the c.g.: its readings carry the rotational terms of a sensor "
+                     "about {abs_estimate:.2f} ± {std_error:.2f} ft {ahead} it ({component}).",
+    "nonlinear_alpha": "The {axis} mismatch curves with angle of attack: the model lacks a nonlinear term, "
+                       "{parameter} = {estimate:.3g} ± {std_error:.2g} {units}.",
+    "coefficient_error": "The model's {parameter} is off: the data say {estimate:.4g} ± {std_error:.2g} {units}, "
+                         "the model has {model_value:.4g} over this maneuver ({model_at_trim:.4g} at its trim).",
+    "cross_coupling": "The {axis} mismatch follows {product}: a coupling term {parameter} = "
+                      "{estimate:.3g} ± {std_error:.2g} {units} is missing{even}.",
+    "flight_condition_drift": "The {axis} mismatch trends with the airspeed change: {parameter} = {estimate:.3g} ± "
+                              "{std_error:.2g} per unit dV/V.",
+    "cg_offset": "The moment reference is {estimate:.2f} ± {std_error:.2f} ft away from where the model puts it "
+                 "(the {axis} mismatch follows the force coefficient).",
+    "sensor_bias": "The {channel} sensor reads {estimate:.4g} ± {std_error:.2g} {units} off: the kinematics of the "
+                   "other channels disagree with it by a constant.",
+    "sensor_scale": "The {channel} sensor has a scale-factor error k = {estimate:.3g} ± {std_error:.2g}.",
+    "sensor_time_skew": "The {channel} channel lags the others by {estimate:.3f} ± {std_error:.3f} s.",
+    "structural_mode": "A narrow spectral peak at {estimate:.2f} Hz in {channel} points to an unmodelled flexible "
+                       "mode.",
+    "turbulence": "The air-relative and inertial velocities disagree broadband (gust RMS about {estimate:.1f} ft/s): "
+                  "the flight was in turbulence, which no deterministic model term can replay.",
+}
+
+
+EXPLAIN_LIGHT_TURBULENCE = (
+    "The air-relative and inertial velocities disagree broadband, and the aerodynamics followed the air-relative "
+    "angle (air share {air_share:.2f} ± {air_share_se:.2f} of the vane-against-inertial difference): the flight was "
+    "in light turbulence (vertical gust RMS about {estimate:.1f} ft/s). Too light to bias the equation-error terms, "
+    "which stand; the sensor tests, which need the kinematics to hold, do not.")
+
+
+class DiagnosisError(RuntimeError):
+    """The diagnosis cannot run: the message names the input and the cause."""
+
+
+def chosen_findings(analysis: Analysis) -> list[Candidate]:
+    """The selected candidates, most significant first; turbulence, when named, leads: it is
+    the broadband mismatch every deterministic term is then fitted against. Light turbulence
+    (the deterministic terms stand in it) follows them."""
+    chosen = [c for c in analysis.candidates if c.selected]
+    return sorted(chosen, key=lambda c: (_turbulence_rank(c), -abs(c.t)))
+
+
+def _turbulence_rank(c: Candidate) -> int:
+    """0 for turbulence (it leads), 2 for light turbulence (it follows), 1 for the others."""
+    if c.effect != "turbulence":
+        return 1
+    return 2 if c.details.get("light") else 0
+
+
+def structured_part(p: Prepared, mismatch: np.ndarray) -> np.ndarray:
+    """The part of a coefficient mismatch that follows the maneuver: its least-squares fit
+    on every state and input regressor (α, q̂, β, p̂, r̂, the surfaces, α̇c̄/2V) and a
+    constant. Measurement noise hardly correlates with them, so this part stands out where
+    the model is wrong, whatever the noise's colour."""
+    reg = cand.regressors(p)
+    cols = [reg[k] for k in sorted(reg) if np.ptp(reg[k]) > 0]
+    cols.append(p.deriv["alpha"] * p.meta["geometry"]["cbar_ft"] / (2.0 * p.smooth["V"]))
+    inner = interior(p)
+    A = np.column_stack([c[inner] for c in cols] + [np.ones(inner.stop - inner.start)])
+    theta, *_ = np.linalg.lstsq(A, mismatch[inner], rcond=None)
+    fitted = A @ theta
+    return fitted - fitted.mean()
+
+
+def focus_axis(findings: list[Candidate]) -> str | None:
+    """The coefficient axis of the first aerodynamic or actuator finding (a delay: the axis
+    its surface mainly drives)."""
+    for f in findings:
+        if f.channel in COEFFICIENTS:
+            return f.channel
+        if f.effect == "control_delay":
+            return {"de": "Cm", "da": "Cl", "dr": "Cn"}.get(f.channel)
+    return None
+
+
+def located_paragraph(a: Analysis, fit_b: dict, name: str, focus: str | None = None) -> dict:
+    """Where model and recording part: per output channel and per axis, and in time and
+    frequency for ``focus`` (the axis of the first finding; else the axis whose mismatch
+    most follows the maneuver)."""
+    p = a.prepared
+    outs = {}
+    for c, v in fit_b["outputs"].items():
+        n = p.noise_std.get(c, 0.0)
+        outs[c] = {**v, "noise_std": n, "ratio": v["rms"] / n if n > 0 else float("inf")}
+    coefs = {}
+    for c in COEFFICIENTS:
+        r = a.mismatch[c] - np.mean(a.mismatch[c])
+        structured = float(np.std(structured_part(p, a.mismatch[c])))
+        coefs[c] = {"rms": float(np.std(r)), "noise_std": a.noise[c], "ratio": float(np.std(r)) / a.noise[c],
+                    "structured_rms": structured, "structured_ratio": structured / a.noise[c],
+                    "pse": fit_b["coefficients"][c]["pse"]}
+    # the axis whose mismatch most follows the maneuver (the raw ratio ranks coloured noise
+    # too: accelerometer noise makes the force axes look worst on a flight with no error),
+    # among the axes the maneuver excited (a pitch maneuver's lateral mismatch is noise)
+    ranked_axes, ranked_outs = excited_axes(p, coefs), _excited_outputs(p, outs)
+    worst_axis = max(ranked_axes, key=lambda c: coefs[c]["structured_ratio"])
+    worst_out = max(ranked_outs, key=lambda c: outs[c]["ratio"]) if ranked_outs else None
+    axis = focus if focus in coefs else worst_axis
+    r = np.zeros(p.n)
+    r[interior(p)] = structured_part(p, a.mismatch[axis])
+    # when: the 2 s window with the largest mismatch energy; where: the band holding most power
+    w = max(1, int(round(2.0 / p.dt)))
+    energy = np.convolve(r ** 2, np.ones(w), mode="valid")
+    i = int(np.argmax(energy))
+    spec = np.abs(np.fft.rfft(r)) ** 2
+    f = np.fft.rfftfreq(r.size, p.dt)
+    cum = np.cumsum(spec) / max(spec.sum(), 1e-300)
+    band = [float(f[int(np.searchsorted(cum, 0.1))]), float(f[min(int(np.searchsorted(cum, 0.9)), f.size - 1)])]
+    ranked = sorted(ranked_axes, key=lambda c: -coefs[c]["structured_ratio"])[:3]
+    where = (f"the findings put it in {axis}" if focus in coefs else f"it is largest in {axis}")
+    summary = ("Coefficient mismatch that follows the maneuver, in noise levels: "
+               + ", ".join(f"{c} {coefs[c]['structured_ratio']:.1f}" for c in ranked)
+               + f"; {where}, most between t = {p.t[i]:.1f} and {p.t[min(i + w, p.n - 1)]:.1f} s, with 80 % of "
+               f"its power in {band[0]:.2f}-{band[1]:.2f} Hz.")
+    if worst_out:
+        summary += (f" Of the outputs, {worst_out} departs most from the model ({outs[worst_out]['ratio']:.1f} "
+                    "times its noise).")
+    return {"outputs": {name: outs}, "coefficients": {name: coefs}, "worst_output": worst_out, "worst_axis": worst_axis,
+            "focus_axis": axis, "time_window_s": [float(p.t[i]), float(p.t[min(i + w, p.n - 1)])], "band_hz": band,
+            "summary": summary}
+
+
+_LON_OUTPUTS = ("alpha", "q", "theta", "V", "ax", "az")
+_LAT_OUTPUTS = ("beta", "p", "r", "phi", "ay")
+
+
+def excited_axes(p: Prepared, names) -> list[str]:
+    """The coefficient axes whose group the maneuver drove (all of them when none was)."""
+    lon, lat = "de" in p.driven, any(s in p.driven for s in ("da", "dr"))
+    keep = [c for c in names if (c in cand.LON and lon) or (c in cand.LAT and lat)]
+    return keep or list(names)
+
+
+def _excited_outputs(p: Prepared, names) -> list[str]:
+    """The output channels whose group the maneuver drove (all of them when none was)."""
+    lon, lat = "de" in p.driven, any(s in p.driven for s in ("da", "dr"))
+    keep = [c for c in names if (c in _LON_OUTPUTS and lon) or (c in _LAT_OUTPUTS and lat)]
+    return keep or list(names)
+
+
+def remaining_mismatch(a: Analysis, fit_b: dict, fit_a: dict) -> dict:
+    """Per axis, the coefficient mismatch left after the findings' terms: RMS over the noise
+    level, and the share of the mismatch RMS the terms removed."""
+    out = {}
+    for c in COEFFICIENTS:
+        before, after = fit_b["coefficients"][c]["rms"], fit_a["coefficients"][c]["rms"]
+        out[c] = {"rms": after, "ratio": after / a.noise[c], "removed": 1.0 - after / before if before > 0 else 0.0}
+    return out
+
+
+# Body axes: x forward, y out of the right wing, z down.
+_OFFSET_WORDS = {"x": ("ahead of", "behind"), "y": ("right of", "left of"), "z": ("below", "above")}
+
+
+def _offset_direction(parameter: str, estimate: float) -> tuple[str, str]:
+    """The body axis an accelerometer-position parameter measures along (``offset_y`` → y;
+    the force-mismatch fit's ``x_accelerometer`` → x) and the words for its sign."""
+    axis = parameter[-1] if parameter.startswith("offset_") else "x"
+    ahead, behind = _OFFSET_WORDS.get(axis, _OFFSET_WORDS["x"])
+    return axis, ahead if estimate >= 0 else behind
+
+
+# A vane bias named on the coefficient means (sensor_naming.name_vane_bias_from_means).
+EXPLAIN_VANE_MEANS = ("The {channel} vane reads {estimate:.4g} ± {std_error:.2g} {units} off: the model evaluated "
+                      "along it is off by its own slopes in that angle times one constant on every axis it reaches.")
+
+
+def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = None) -> dict:
+    fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
+           "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
+    if c.effect == "coefficient_error":
+        fmt["model_value"] = c.estimate - c.details["change"]
+        fmt["model_at_trim"] = c.details.get("model_at_trim", float("nan"))
+    fmt["abs_estimate"] = abs(c.estimate)
+    fmt["component"], fmt["ahead"] = _offset_direction(c.parameter, c.estimate)
+    even = c.parameter.endswith("_beta_abs")
+    fmt["product"] = "|beta|, an even function of sideslip" if even else "(alpha - alpha_trim)·beta"
+    fmt["even"] = (" (or, as here, the model has one of opposite sign: a symmetric airframe's rolling and yawing "
+                   "moments are odd in sideslip)") if even else ""
+    template = (EXPLAIN_VANE_MEANS if c.test in MEANS_TESTS.values() else
+                EXPLAIN_LIGHT_TURBULENCE if c.details.get("light") else EXPLAIN[c.effect])
+    share = c.details.get("air_share") or {}
+    fmt["air_share"], fmt["air_share_se"] = share.get("share", float("nan")), share.get("std_error", float("nan"))
+    try:
+        text = template.format(**fmt)
+    except (KeyError, ValueError):
+        text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
+    if c.details.get("not_ruled_out"):  # an assumption the result rests on (term_rules._withhold_skewed_delay)
+        text += f" Caveat: {c.details['not_ruled_out']}."
+    evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
+    evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
+    if check is not None:
+        evidence["validation"] = check
+        if check["status"] == "untested":  # an assumption the result rests on: the identification alone
+            why = check["reason"]
+            text += f" {why[:1].upper()}{why[1:]}: it rests on the identification maneuver alone."
+        if check["status"] == "contradicted" and "change" in check:
+            text += (f" The validation maneuver contradicts it (its {', '.join(check['axes'])} mismatch grows by "
+                     f"{100 * check['change']:.0f} % with the term), so it is not in the augmented model.")
+        elif check["status"] == "contradicted":  # a sensor test: the same test there says the opposite
+            text += (f" The validation maneuver contradicts it (the same test there gives {check['estimate']:.4g} ± "
+                     f"{check['std_error']:.2g} {c.units}, t = {check['t']:.1f}), so it is not in the augmented model.")
+    return {"effect": c.effect, "axis": c.axis if c.axis in ("pitch", "roll", "yaw", "lon", "lat") else None,
+            "channel": c.channel, "parameter": c.parameter, "estimate": float(c.estimate),
+            "std_error": float(c.std_error), "units": c.units, "evidence": evidence,
+            "fit_before": fits_b, "fit_after": fits_a, "explanation": text}
+
+
+def none_finding(a: Analysis, fits_b: dict) -> dict:
+    top = sorted(a.candidates, key=lambda c: -abs(c.t))[:5]
+    ratios = {c: round(float(np.std(a.mismatch[c] - a.mismatch[c].mean()) / a.noise[c]), 2) for c in COEFFICIENTS}
+    return {"effect": "none", "axis": None, "channel": None, "parameter": "", "estimate": 0.0, "std_error": 0.0,
+            "units": "", "evidence": {
+                "strongest_candidates": [{"effect": c.effect, "parameter": c.parameter, "t": c.t,
+                                          "explained_fraction": c.explained_fraction, "reason": c.reason} for c in top],
+                "entry_t": cand.T_IN, "mismatch_to_noise": ratios},
+            "fit_before": fits_b, "fit_after": fits_b,
+            "explanation": "No candidate effect is both significant against the noise the data themselves show "
+                           f"and large enough to matter (at least {100 * cand.PRACTICAL_SHARE:.0f} % of its "
+                           "coefficient's excursion): the mismatch is explained by measurement noise alone, within "
+                           "what this maneuver could test (see not_checked)."}
+
+
+# The factor by which the model's lift along the recorded states may differ from the
+# measured before the model is refused as another aircraft. None of the effects of
+# effects.md comes near it: a 3-degree alpha bias moves the F-16's lift by about 25 %; the
+# Twin Otter against JSBSim's DHC6 differs by 6 %, an F-16 recording against the 737 by 49 %
+# and the Twin Otter against the F-16 by a factor of 3.2.
+LIFT_FACTOR = 1.5
+# The factor by which the recording's reference geometry (S, b, c̄) may differ from the
+# model's: coefficients are normalised by them, so a model of another size is another
+# aircraft (the F-16's S is 300 ft², the 737's 1,171 ft², the Twin Otter's 420 ft² in both the
+# SIDPAC file and JSBSim's DHC6).
+GEOMETRY_FACTOR = 1.25
+
+
+def check_model_represents(a: Analysis, model: str) -> None:
+    """Refuse a model that cannot stand for the recorded aircraft: its reference geometry
+    differs from the recording's by more than :data:`GEOMETRY_FACTOR`, or its normal-force
+    coefficient along the recorded states differs from the measured one by more than
+    :data:`LIFT_FACTOR` (skipped when the measured mean is under 0.05, near zero lift).
+
+    Raises
+    ------
+    DiagnosisError
+        Naming the model, both lift levels and why no effect explains the difference.
+    """
+    geometry = a.prepared.meta["geometry"]
+    tp = a.aero.trim
+    for key, value, label in (("S_ft2", tp.S_ft2, "wing area"), ("b_ft", tp.b_ft, "span"),
+                              ("cbar_ft", tp.cbar_ft, "mean chord")):
+        ratio = float(geometry[key]) / value if value > 0 else float("inf")
+        if not 1.0 / GEOMETRY_FACTOR <= ratio <= GEOMETRY_FACTOR:
+            raise DiagnosisError(
+                f"--model {model} does not represent the recorded aircraft: the recording's {label} is "
+                f"{float(geometry[key]):g} ({key}) where the model's is {value:g}, a factor of "
+                f"{max(ratio, 1 / ratio):.2f} (beyond {GEOMETRY_FACTOR:g}): another aircraft, or another "
+                "reference geometry for the coefficients")
+    measured = float(np.mean(a.mismatch["CZ"] + a.aero.coefficients["CZ"]))
+    modelled = float(np.mean(a.aero.coefficients["CZ"]))
+    if abs(measured) < 0.05:
+        return
+    ratio = modelled / measured
+    if not 1.0 / LIFT_FACTOR <= ratio <= LIFT_FACTOR:
+        trim = f" (and it cannot trim there: {a.aero.trim_failed})" if a.aero.trim_failed else ""
+        raise DiagnosisError(
+            f"--model {model} does not represent the recorded aircraft: along the recorded states its normal-force "
+            f"coefficient averages {modelled:.3f} where the recording's is {measured:.3f} (a factor of "
+            f"{max(ratio, 1 / ratio) if ratio > 0 else float('inf'):.2f}, beyond {LIFT_FACTOR:g}){trim}; no effect the "
+            "diagnosis can name explains that much")
+
+
+def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
+    """The effects (or their parameters) this recording cannot test, each with the reason:
+    terms built on states or surfaces the maneuver did not drive, delays of surfaces that
+    never moved, sensor scale factors and skews of channels that hardly move, what the
+    sample rate hides, and the missing validation maneuver."""
+    p = a.prepared
+    grouped: dict[tuple[str, str], list[str]] = {}
+    for rows in a.not_offered.values():
+        for r in rows:
+            why = r.get("reason") or undriven_reason(p, r["sources"])
+            grouped.setdefault((r["effect"], why), []).append(r["parameter"])
+    for s in SURFACES:
+        if s in p.raw and s not in p.driven:
+            grouped.setdefault(("control_delay", undriven_reason(p, [s])), []).append(f"tau_{s}")
+    for name, why in sorted(a.kinematic.dropped.items()):  # in a fixed order, run to run
+        kind = name.split("_", 1)[0]
+        effect = {"scale": "sensor_scale", "skew": "sensor_time_skew"}.get(kind, "sensor_" + kind)
+        grouped.setdefault((effect, why), []).append(name)
+    out = [{"effect": e, "parameters": sorted(dict.fromkeys(ps)), "reason": why} for (e, why), ps in grouped.items()]
+    if a.gusty:
+        out += [{"effect": e, "parameters": [], "reason": a.gusty}
+                for e in ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")]
+    if vane_wander(a.air, a.gusty):
+        out.append({"effect": "coefficient_error", "parameters": ["terms in alpha, its powers and alphadot"],
+                    "reason": a.gusty})
+    out.append({"effect": "structural_mode", "parameters": [],
+                "reason": f"only modes below {0.5 / p.dt:g} Hz (half the sample rate) can be seen"})
+    if not validation_given:
+        out.append({"effect": "(every finding)", "parameters": [],
+                    "reason": "no validation maneuver was given: no finding was tested on a second maneuver"})
+    return out
+
+
+def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
+    """What the diagnosis assumed: the recording's stand-ins (:attr:`Prepared.assumptions`),
+    with the thrust value used, and the mass the model flew with."""
+    out = [dict(x) for x in a.prepared.assumptions]
+    for x in out:
+        if x["item"] == "thrust" and "model's" in x["stood_in_by"]:
+            x["stood_in_by"] += f": {a.aero.trim.thrust_lbf:.0f} lbf"
+    out.append({"item": "model mass", "missing": "-",
+                "stood_in_by": ("the recording's mass and inertia (first sample)" if mass == "recording" else
+                                f"the model's own mass and inertia ({aircraft.name}"
+                                + _mass_difference(a.prepared.mass, a.aero.trim)
+                                + "); --mass recording flies it with the recording's")})
+    trim = a.aero.trim
+    if trim.held:
+        for surface, info in trim.held.items():
+            out.append({"item": f"model trim ({surface})", "missing": "-", "stood_in_by": info["reason"]})
+    out.append({"item": "surface levels (replays)", "missing": "-",
+                "stood_in_by": ("each surface moves by its recorded change from a start level fitted, per replay, "
+                                "within the noise of its first 0.5 s (fit_before/fit_after: surface_levels_deg; "
+                                "harness/diagnosis/levels.py)")})
+    return out
+
+
+# A recording's mass or inertia this far from the model's is named in the model-mass assumption.
+MASS_NOTE_FRACTION = 0.02
+
+
+def _mass_difference(recorded: dict, trim) -> str:
+    """', the recording's mass 15 % below it, Iy 10 % below' for the ones that differ from the
+    model's by :data:`MASS_NOTE_FRACTION` or more at the recording's start ('' when none does):
+    the coefficients are measured with the recording's, the replays fly the model's."""
+    words = []
+    for key, label in (("mass_slug", "mass"), ("Ix_slugft2", "Ix"), ("Iy_slugft2", "Iy"), ("Iz_slugft2", "Iz")):
+        model = float(getattr(trim, key))
+        got = recorded.get(key)
+        if got is None or model <= 0:
+            continue
+        rel = float(np.asarray(got, dtype=float).ravel()[0]) / model - 1.0
+        if abs(rel) >= MASS_NOTE_FRACTION:
+            words.append(f"{label} {100 * abs(rel):.0f} % {'above' if rel > 0 else 'below'} it")
+    return (", the recording's " + ", ".join(words)) if words else ""
