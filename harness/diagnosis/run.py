@@ -13,7 +13,7 @@ from harness.diagnosis.analysis import analyse
 from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_all, refine_in_the_loop, replay_before,
                                          sensor_models, terms_of, unsupported_in_the_loop, with_calibration,
                                          write_model)
-from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import instruments_at_cg, prepare
 from harness.diagnosis.sensor_naming import name_replicated
 from harness.diagnosis.validation import undecided, validation_check
@@ -123,9 +123,10 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
                          workers=calibrate_workers, pool=pool)
 
 
-def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str,
-              calibrate: bool = True, workers: int = 2, pool: LocalPool | None = None) -> dict:
-    t0 = time.perf_counter()
+def _loaded(model: str, recording: str | Path, validation: str | Path | None,
+            mass: str) -> tuple[Aircraft, dict]:
+    """The aircraft (with the recording's mass when asked) and the recordings, instruments at
+    the c.g."""
     aircraft = _aircraft(model)
     rec = instruments_at_cg(read_recording(recording))
     if mass == "recording":
@@ -135,33 +136,83 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     recs = {"identification": rec}
     if validation is not None:
         recs["validation"] = instruments_at_cg(read_recording(validation))
+    return aircraft, recs
+
+
+def _checked(a: Analysis, av: Analysis | None) -> tuple[list[Candidate], list[Candidate], dict[int, dict | None]]:
+    """The findings kept, those reported apart, and each one's validation check. A finding
+    is kept only when the validation maneuver confirms it (or cannot test it: a gust level, a
+    spectral peak, a coupling it does not excite, :func:`validation.untestable`)."""
+    if av is not None:  # sensor biases each maneuver only suspects, named on the two
+        name_replicated(a, av)
+    findings = chosen_findings(a)
+    checks = {id(f): validation_check(av, f) if av is not None else undecided(f) for f in findings}
+    unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"]
+                   not in ("confirmed", "untested")]
+    return [f for f in findings if f not in unconfirmed], unconfirmed, checks
+
+
+def _calibrated(model: str, recs: dict, aircraft: Aircraft, mass: str, workers: int, maneuvers: dict,
+                befores: dict, a: Analysis, findings: list[Candidate], unconfirmed: list[Candidate],
+                checks: dict, flown: dict, pool: LocalPool | None):
+    """The calibration in the loop; a term it sizes at nothing is withdrawn (reported apart)
+    and the others are flown and calibrated again without it. Returns the calibration, the
+    findings, the unconfirmed, the modelled terms, the added effects and the flights."""
+    modelled = list(findings)
+    added = terms_of(modelled, a.applied)
+    calibration, modelled, added, flown = refine_in_the_loop(model, recs, aircraft, mass, workers, maneuvers,
+                                                             befores, modelled, added, flown, pool)
+    withdrawn = unsupported_in_the_loop(findings, calibration, checks)
+    if withdrawn:
+        unconfirmed = unconfirmed + withdrawn
+        findings = [f for f in findings if f not in withdrawn]
+        modelled = list(findings)
+        added = terms_of(modelled, a.applied)
+        flown = fly_all(maneuvers, aircraft, added, modelled, befores, pool=pool)
+        calibration, modelled, added, flown = refine_in_the_loop(model, recs, aircraft, mass, workers, maneuvers,
+                                                                 befores, modelled, added, flown, pool)
+    return calibration, findings, unconfirmed, modelled, added, flown
+
+
+def _after_findings(located: dict, a: Analysis, findings: list[Candidate]) -> None:
+    """Add to the located paragraph what mismatch the findings leave (:data:`UNEXPLAINED_RATIO`)."""
+    if not findings:
+        return
+    worst = max(excited_axes(a.prepared, located["remaining"]), key=lambda c: located["remaining"][c]["ratio"])
+    w = located["remaining"][worst]
+    removed = f"{100 * w['removed']:.0f} % of it removed" if w["removed"] >= 0.005 else "none of it removed"
+    if w["ratio"] >= UNEXPLAINED_RATIO:
+        located["summary"] += (f" After the findings, the mismatch left in {worst} is still {w['ratio']:.1f} times "
+                               f"its noise level ({removed})"
+                               + (": no candidate term explains it." if w["removed"] < 0.2 else "."))
+    else:
+        located["summary"] += (f" After the findings, no axis's mismatch is above {UNEXPLAINED_RATIO:g} times its "
+                               f"noise level (largest: {worst}, {w['ratio']:.1f}).")
+
+
+def _write_series(out: Path, series: dict) -> None:
+    (out / "series").mkdir(parents=True, exist_ok=True)
+    for name, df in series.items():
+        write_atomic(out / "series" / f"{name}.parquet", lambda fh, df=df: df.to_parquet(fh, index=False))
+
+
+def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str,
+              calibrate: bool = True, workers: int = 2, pool: LocalPool | None = None) -> dict:
+    t0 = time.perf_counter()
+    aircraft, recs = _loaded(model, recording, validation, mass)
     pending = None
     if validation is not None and pool is not None:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
-    p = prepare(rec, "identification")
+    p = prepare(recs["identification"], "identification")
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude)
     a = analyse(p, aircraft, ic)
     check_model_represents(a, model)
     befores = {"identification": replay_before(p, aircraft, a)}
+    av = None
     if validation is not None:
         pv, av, befores["validation"] = (pending.result() if pending is not None else
                                          analysed(recs["validation"], "validation", aircraft))
-    if validation is not None:  # sensor biases each maneuver only suspects, named on the two
-        name_replicated(a, av)
-    findings = chosen_findings(a)
-    checks: dict[int, dict | None] = {}
-    unconfirmed: list[Candidate] = []
-    if validation is not None:
-        checks = {id(f): validation_check(av, f) for f in findings}
-    else:
-        av = None
-        checks = {id(f): undecided(f) for f in findings}
-    # a finding is kept only when the validation maneuver confirms it (or cannot test it:
-    # a gust level, a spectral peak, a coupling it does not excite, :func:`untestable`);
-    # the others are reported apart, not as findings
-    unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"]
-                   not in ("confirmed", "untested")]
-    findings = [f for f in findings if f not in unconfirmed]
+    findings, unconfirmed, checks = _checked(a, av)
     modelled = list(findings)
     added = terms_of(modelled, a.applied)
     timing = {"analysis": time.perf_counter() - t0}
@@ -172,34 +223,15 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     calibration = {"used": False, "reason": "not asked for (calibrate=False, --no-calibrate)"}
     if calibrate:
         t1 = time.perf_counter()
-        calibration, modelled, added, flown = refine_in_the_loop(model, recs, aircraft, mass, workers, maneuvers,
-                                                                 befores, modelled, added, flown, pool)
-        withdrawn = unsupported_in_the_loop(findings, calibration, checks)
-        if withdrawn:  # the others are flown and calibrated again without it
-            unconfirmed += withdrawn
-            findings = [f for f in findings if f not in withdrawn]
-            modelled = list(findings)
-            added = terms_of(modelled, a.applied)
-            flown = fly_all(maneuvers, aircraft, added, modelled, befores, pool=pool)
-            calibration, modelled, added, flown = refine_in_the_loop(model, recs, aircraft, mass, workers,
-                                                                     maneuvers, befores, modelled, added, flown, pool)
+        calibration, findings, unconfirmed, modelled, added, flown = _calibrated(
+            model, recs, aircraft, mass, workers, maneuvers, befores, a, findings, unconfirmed, checks, flown, pool)
         timing["calibration"] = time.perf_counter() - t1
     _, fb_id, fa_id, series_id = flown["identification"]
     fits_b, fits_a = {"identification": fb_id}, {"identification": fa_id}
     series = {"identification": series_id}
     located = located_paragraph(a, fb_id, "identification", focus_axis(findings))
     located["remaining"] = remaining_mismatch(a, fb_id, fa_id)
-    if findings:
-        worst = max(excited_axes(a.prepared, located["remaining"]), key=lambda c: located["remaining"][c]["ratio"])
-        w = located["remaining"][worst]
-        removed = f"{100 * w['removed']:.0f} % of it removed" if w["removed"] >= 0.005 else "none of it removed"
-        if w["ratio"] >= UNEXPLAINED_RATIO:
-            located["summary"] += (f" After the findings, the mismatch left in {worst} is still {w['ratio']:.1f} times "
-                                   f"its noise level ({removed})"
-                                   + (": no candidate term explains it." if w["removed"] < 0.2 else "."))
-        else:
-            located["summary"] += (f" After the findings, no axis's mismatch is above {UNEXPLAINED_RATIO:g} times its "
-                                   f"noise level (largest: {worst}, {w['ratio']:.1f}).")
+    _after_findings(located, a, findings)
     if av is not None:
         av, fb_v, fa_v, series_v = flown["validation"]
         fits_b["validation"], fits_a["validation"] = fb_v, fa_v
@@ -225,8 +257,6 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         "timing_s": timing,
         "seed": None,
     }
-    (out / "series").mkdir(parents=True, exist_ok=True)
-    for name, df in series.items():
-        write_atomic(out / "series" / f"{name}.parquet", lambda fh, df=df: df.to_parquet(fh, index=False))
+    _write_series(out, series)
     write_text_atomic(out / "findings.json", json.dumps(jsonable(result), indent=1))
     return result
