@@ -852,3 +852,37 @@ def test_an_alpha_power_the_inertial_alpha_calls_linear_is_withheld(monkeypatch)
     assert not linear.selected and "inertial α" in linear.reason
     cubic = _alpha_power_case(0.0, -800.0, monkeypatch)
     assert cubic.selected and cubic.reason == "entered"
+
+
+def test_a_recorders_anti_alias_filter_is_the_noise_floors_shape():
+    """prepare.recorder_noise_shape and the smoothing it feeds: white noise (σ 0.01) through
+    a causal 4th-order Butterworth at half the Nyquist frequency before sampling, on a slow
+    maneuver. Under the white-floor assumption the noise level comes out near zero (the
+    cut-off lands where the filtered noise meets nothing); with the floor's own shape it is
+    the recorded noise's level, within 15 % (its standard deviation over the record: σ times
+    the filter's power gain over the band, √0.5 for an ideal half-band filter). The
+    unfiltered record's floor is flat: no shape, the same smoothing as before."""
+    from scipy import signal as sg
+
+    from estimators.smoothing import optimal_fourier_smoother
+    from harness.diagnosis.prepare import _own_smoothing, recorder_noise_shape
+    rng = np.random.default_rng(12)
+    fs, n = 50.0, 1500
+    t = np.arange(n) / fs
+    slow = 0.05 * np.sin(2 * np.pi * 0.3 * t) * np.exp(-((t - 12) / 6) ** 2)
+    white = 0.01 * rng.standard_normal(n)
+    b, a = sg.butter(4, 0.5)
+    recorded_noise = sg.lfilter(b, a, white)
+    raw = {c: slow + (sg.lfilter(b, a, 0.01 * rng.standard_normal(n)) if c != "alpha" else recorded_noise)
+           for c in ("alpha", "beta", "p", "q", "r")}
+    plain = optimal_fourier_smoother(raw["alpha"], 1 / fs)
+    assert np.sqrt(plain.noise_variance) < 0.2 * np.std(recorded_noise[100:])
+    shape = recorder_noise_shape(plain.coefficients ** 2, plain.frequencies_hz)
+    assert shape is not None and shape[0] == 1.0 and shape[-1] < 0.01
+    fits, filtered = _own_smoothing(raw, 1 / fs)
+    assert set(filtered) == set(raw)
+    assert np.sqrt(fits["alpha"].noise_variance) == pytest.approx(np.std(recorded_noise[100:]), rel=0.15)
+    unfiltered = {c: slow + 0.01 * rng.standard_normal(n) for c in raw}
+    fits, filtered = _own_smoothing(unfiltered, 1 / fs)
+    assert filtered == []
+    assert fits["alpha"].noise_variance == optimal_fourier_smoother(unfiltered["alpha"], 1 / fs).noise_variance

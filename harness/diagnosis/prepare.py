@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import ndimage
 
 from estimators.coefficients import accelerometer_at_cg, force_coefficients, moment_coefficients
 from estimators.differentiation import local_polynomial_derivative
@@ -245,7 +246,12 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
         raise ValueError(f"recording {rec.name!r} is {t[-1]:.1f} s long; the diagnosis needs at least 4 s")
     dt = float((t[-1] - t[0]) / (t.size - 1))
     assumptions = list(_stand_ins(raw, rec.meta, tuple(rec.data.columns)))
-    fits = {c: optimal_fourier_smoother(x, dt) for c, x in raw.items()}
+    fits, filtered = _own_smoothing(raw, dt)
+    if filtered:
+        assumptions.append({"item": "noise floor", "missing": "a flat (white) noise floor to the Nyquist frequency",
+                            "stood_in_by": "the floor each channel shows, falling at the top of the band on "
+                                           f"{', '.join(filtered)} (an anti-alias filter before sampling): the "
+                                           "noise levels are measured under that shape"})
     noise = {c: float(np.sqrt(max(f.noise_variance, 0.0))) for c, f in fits.items()}
     excited = tuple(c for c, f in fits.items() if about_trend(f.smoothed) > 5.0 * max(noise[c], 1e-12))
     w = common_weights(fits, excited, t.size)
@@ -278,6 +284,70 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
                     excited=excited, measured=measured, start=start, meta=dict(rec.meta),
                     own_noise=own_noise, mass=mass, driven=driven, moved=moved, assumptions=tuple(assumptions),
                     altitude=altitude, recording=rec)
+
+
+# A recorder's anti-alias filter: a noise floor flat over 0.15-0.3 of the Nyquist frequency
+# (its two halves within FLAT_FACTOR of each other: white noise, above the maneuver's band)
+# whose top tenth of the band lies under RECORDER_FALL of that level (white noise: 1 within a
+# few %, hundreds of coefficients in each band; a 4th-order filter at half the Nyquist
+# frequency: 0.006; a noise-free channel's own spectrum keeps falling through the flat band).
+RECORDER_FALL = 0.1
+FLAT_FACTOR = 2.0
+
+
+def recorder_noise_shape(power: np.ndarray, freqs: np.ndarray) -> np.ndarray | None:
+    """The shape of a noise floor that falls at the top of the band, as a recorder's
+    anti-alias filter leaves it, from the sine-series power ``power`` at ``freqs``; None when
+    the floor does not fall there (white noise: the optimal smoother's own assumption).
+
+    The optimal Fourier smoother (seed section III.A) takes the coefficients above its
+    cut-off for the noise floor and assumes that floor flat to the Nyquist frequency. A
+    record filtered before it was sampled has noise only up to the filter's corner: the
+    cut-off then lands where the filtered noise meets nothing, the noise is kept as signal
+    and its level is taken as almost zero (5e-8 rad for a 0.1° α vane behind a 12.5 Hz
+    4th-order filter at 50 Hz), and every test that weighs a term against the noise goes
+    wrong. The floor must be flat over 0.15-0.3 of the Nyquist frequency
+    (:data:`FLAT_FACTOR`) and fall under :data:`RECORDER_FALL` of that level at the top.
+    Its shape is then its running median (±2 % of the band; medians of χ² ordinates on both
+    sides, so their ratio is unbiased) over its median level there, capped at 1, and 1 below
+    0.15 of the Nyquist frequency (white noise before the filter): the smoother's
+    ``noise_shape``."""
+    nyquist = float(freqs[-1])
+    ref = (freqs >= 0.15 * nyquist) & (freqs < 0.3 * nyquist)
+    low, high = ref & (freqs < 0.225 * nyquist), ref & (freqs >= 0.225 * nyquist)
+    top = freqs >= 0.9 * nyquist
+    if not (low.sum() >= 10 and high.sum() >= 10 and top.sum() >= 10):
+        return None
+    level, lower, upper = (float(np.median(power[m])) for m in (ref, low, high))
+    flat = lower > 0.0 and upper > 0.0 and 1.0 / FLAT_FACTOR <= upper / lower <= FLAT_FACTOR
+    if not flat or float(np.median(power[top])) >= RECORDER_FALL * level:
+        return None
+    half = max(5, int(0.02 * power.size))
+    floor = ndimage.median_filter(power, size=2 * half + 1, mode="nearest")
+    shape = np.minimum(floor / level, 1.0)
+    shape[freqs < 0.15 * nyquist] = 1.0
+    return np.maximum(shape, 1e-12)
+
+
+# The share of the recorded outputs whose floor must fall for the recording to be taken as
+# filtered before sampling (a recorder's filter acts on every channel; one channel's own
+# falling spectrum, a smooth surface or thrust history, is not one).
+RECORDER_SHARE = 2.0 / 3.0
+
+
+def _own_smoothing(raw: dict[str, np.ndarray], dt: float) -> tuple[dict, list[str]]:
+    """Each channel's own optimal smoothing, and the channels smoothed under the noise floor's
+    own shape (:func:`recorder_noise_shape`): those whose floor falls, when at least
+    :data:`RECORDER_SHARE` of the recorded outputs show a recorder's anti-alias filter."""
+    fits = {c: optimal_fourier_smoother(x, dt) for c, x in raw.items()}
+    shapes = {c: recorder_noise_shape(f.coefficients ** 2, f.frequencies_hz) for c, f in fits.items()}
+    outputs = [c for c in OUTPUTS if c in raw]
+    if not outputs or sum(shapes[c] is not None for c in outputs) < RECORDER_SHARE * len(outputs):
+        return fits, []
+    filtered = [c for c in raw if shapes[c] is not None]
+    for c in filtered:
+        fits[c] = optimal_fourier_smoother(raw[c], dt, noise_shape=shapes[c])
+    return fits, filtered
 
 
 def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...]) -> list[dict]:
