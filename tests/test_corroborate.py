@@ -3,7 +3,7 @@ noise-free data, and the verdict follows its three rules."""
 import numpy as np
 import pytest
 
-from harness.diagnosis.corroborate import AxisRatio, axis_ratio, corroborate
+from harness.diagnosis.corroborate import AxisRatio, axis_ratio, corroborate, inverse_variance_mean
 
 
 def test_axis_ratio_recovers_the_multiple_of_the_signature_exactly():
@@ -85,3 +85,12 @@ def test_inertial_angles_recover_alpha_without_the_vanes_wander():
     A = np.column_stack([np.ones(n), t])
     placed = wander - A @ np.linalg.lstsq(A, wander, rcond=None)[0]
     assert np.std(got - alpha) < 0.25 * np.std(placed)
+
+
+def test_inverse_variance_mean_of_two_estimates():
+    """(1/σ₁² x₁ + 1/σ₂² x₂)/(1/σ₁² + 1/σ₂²) and 1/√(1/σ₁² + 1/σ₂²): 0.10 ± 0.01 and
+    0.13 ± 0.02 give 0.106 ± 0.01/√1.25; equal errors give the plain mean and σ/√2."""
+    est, se = inverse_variance_mean([0.10, 0.13], [0.01, 0.02])
+    assert est == pytest.approx((0.10 * 1e4 + 0.13 * 2.5e3) / 1.25e4) and se == pytest.approx(0.01 / np.sqrt(1.25))
+    est, se = inverse_variance_mean([1.0, 3.0], [0.5, 0.5])
+    assert est == pytest.approx(2.0) and se == pytest.approx(0.5 / np.sqrt(2.0))

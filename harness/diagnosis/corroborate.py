@@ -107,6 +107,13 @@ class Agreement:
         return ", ".join(f"{a.axis} {a.ratio:.2f} ± {a.std_error:.2f}" for a in self.axes)
 
 
+def inverse_variance_mean(estimates, std_errors) -> tuple[float, float]:
+    """The inverse-variance weighted mean of independent estimates and its standard error,
+    1/√Σσ⁻² (the minimum-variance unbiased combination)."""
+    w = 1.0 / np.square(np.asarray(std_errors, dtype=float))
+    return float(np.dot(w, np.asarray(estimates, dtype=float)) / w.sum()), float(1.0 / np.sqrt(w.sum()))
+
+
 def agreement(ratios: dict[str, AxisRatio]) -> Agreement | None:
     """The axes that can tell (σ at most :data:`INFORMATIVE_SE`), their inverse-variance
     common ratio, and those that depart from it by more than :data:`AGREE_Z` standard
@@ -115,10 +122,9 @@ def agreement(ratios: dict[str, AxisRatio]) -> Agreement | None:
                  if np.isfinite(r.std_error) and r.std_error <= INFORMATIVE_SE)
     if not axes:
         return None
-    w = np.array([1.0 / a.std_error ** 2 for a in axes])
-    a_hat = float(np.sum(w * np.array([a.ratio for a in axes])) / np.sum(w))
+    a_hat, se = inverse_variance_mean([a.ratio for a in axes], [a.std_error for a in axes])
     apart = tuple(a for a in axes if abs(a.ratio - a_hat) > max(AGREE_Z * a.std_error, AGREE_FRACTION * abs(a_hat)))
-    return Agreement(axes, a_hat, float(1.0 / np.sqrt(np.sum(w))), apart)
+    return Agreement(axes, a_hat, se, apart)
 
 
 def imitates(ratios: dict[str, AxisRatio], *, t_aero: float) -> Agreement | None:
@@ -132,9 +138,8 @@ def imitates(ratios: dict[str, AxisRatio], *, t_aero: float) -> Agreement | None
     finite = [r for r in ratios.values() if np.isfinite(r.std_error) and r.std_error > 0]
     if not finite:
         return None
-    w = np.array([1.0 / r.std_error ** 2 for r in finite])
-    a0 = float(np.sum(w * np.array([r.ratio for r in finite])) / np.sum(w))
-    if abs(a0) * np.sqrt(np.sum(w)) < t_aero:
+    a0, s0 = inverse_variance_mean([r.ratio for r in finite], [r.std_error for r in finite])
+    if abs(a0) / s0 < t_aero:
         return None
     ag = agreement({k: AxisRatio(k, r.ratio / a0, r.std_error / abs(a0)) for k, r in ratios.items()})
     if ag is None or len(ag.axes) < 2 or ag.apart:
@@ -167,7 +172,6 @@ def corroborate(name: str, kinematic: float, kinematic_std: float, ratios: dict[
         return verdict(False, f"the coefficient mismatch asks for {a_hat:.2f} ± {sa:.2f} times the kinematic "
                        "size", a_hat, sa)
     v_aero, s_aero = a_hat * kinematic, abs(sa * kinematic)
-    wk, wa = 1.0 / kinematic_std ** 2, 1.0 / s_aero ** 2
-    est = (wk * kinematic + wa * v_aero) / (wk + wa)
+    est, se = inverse_variance_mean([kinematic, v_aero], [kinematic_std, s_aero])
     return verdict(True, "named on two independent tests: the kinematics and the coefficient mismatch ("
-                   + ", ".join(a.axis for a in axes) + ") agree on it", a_hat, sa, est, 1.0 / np.sqrt(wk + wa))
+                   + ", ".join(a.axis for a in axes) + ") agree on it", a_hat, sa, est, se)

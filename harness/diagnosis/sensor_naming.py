@@ -345,8 +345,7 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
             continue
         if abs(c.estimate - v.estimate) > 2.0 * np.hypot(c.std_error, v.std_error):
             continue
-        w1, w2 = c.std_error ** -2, v.std_error ** -2
-        est, se = (w1 * c.estimate + w2 * v.estimate) / (w1 + w2), (w1 + w2) ** -0.5
+        est, se = corroborate.inverse_variance_mean([c.estimate, v.estimate], [c.std_error, v.std_error])
         if abs(est) / se < KIN_T_IN or kinematic_rival(kin, c.parameter) is not None:
             continue
         if not sensor_verdict(c.parameter, est, se, True, kin, p, False, True)[0]:

@@ -10,6 +10,7 @@ from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, model_along
+from harness.diagnosis.corroborate import inverse_variance_mean
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import NOT_IN_TURBULENCE
 from harness.diagnosis.kinematics import KinematicResult, channel_share, is_plausible, is_practical, kinematic_check
@@ -93,9 +94,7 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
             _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, V_mean)
             continue
         k_exc, se_exc, named = scale.estimate, scale.std_error, scale.selected
-        w = np.array([1.0 / se_off ** 2, 1.0 / se_exc ** 2])
-        k = float(np.dot(w, [k_off, k_exc]) / w.sum())
-        se = float(1.0 / np.sqrt(w.sum()))
+        k, se = inverse_variance_mean([k_off, k_exc], [se_off, se_exc])
         if not (is_plausible(scale.parameter, k, V_mean) and is_practical(scale.parameter, k, p.dt)):
             continue
         scale.estimate, scale.std_error, scale.t, scale.selected = k, se, k / se, True

@@ -7,6 +7,7 @@ import numpy as np
 
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import interior
+from harness.diagnosis.corroborate import inverse_variance_mean
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import MEANS_TESTS
@@ -260,9 +261,7 @@ def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | N
     k_off, se_off = reading["k"], reading["k_std"]
     if abs(k_off - twin.estimate) > 2.0 * np.hypot(se_off, twin.std_error):
         return None
-    w = np.array([1.0 / se_off ** 2, 1.0 / twin.std_error ** 2])
-    k = float(np.dot(w, [k_off, twin.estimate]) / w.sum())
-    se = float(1.0 / np.sqrt(w.sum()))
+    k, se = inverse_variance_mean([k_off, twin.estimate], [se_off, twin.std_error])
     return {"status": _same_instrument_status(k, k / se, f.estimate), "axes": [], "estimate": k, "std_error": se,
             "t": k / se, "rule": f"the offset at the mean {channel} (k = {k_off:.3f} ± {se_off:.3f}) and the "
             f"excursions (k = {twin.estimate:.3f} ± {twin.std_error:.3f}) agree"}
