@@ -620,6 +620,47 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     assert bias.details["as_scale"]["k"] == pytest.approx(0.1)  # the reading the validation test uses
 
 
+def test_the_mismatchs_shape_reads_a_vane_scales_excursions_beside_its_offset():
+    """sensor_rules.scale_read_as_bias with the coefficient mismatch's shape along the vane
+    (details['shape'], sensor_naming.withhold_vane_scale): the excursions are read as the
+    inverse-variance mean of the kinematic k (0.066 ± 0.032, t 2.1, under the suspicion t)
+    and the shape's (0.166 ± 0.044), and a bias of t 17 that is no practical bias
+    (unselected) is read as the scale's offset (k = 0.0043/0.0431 = 0.100 ± 0.006): the
+    scale is named at the mean of the two readings. Without the shape the same bias and
+    kinematic k name nothing; with a shape of the other sign, nothing either."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_rules import excursion_scale, scale_read_as_bias
+    p = SimpleNamespace(smooth={"alpha": np.full(100, 0.0474), "V": np.full(100, 700.0)}, dt=0.02)
+
+    def pair(shape):
+        bias = Candidate("sensor_bias", None, "alpha", "bias_alpha", 0.0043, 0.00025, 17.2, 0.0, "rad",
+                         "kinematic consistency (bias always fitted)", False,
+                         "within the instrument noise budget (practical size)")
+        scale = Candidate("sensor_scale", None, "alpha", "scale_alpha", 0.066, 0.032, 2.06, 0.01, "1",
+                          "kinematic consistency", False, "below the entry t",
+                          {} if shape is None else {"shape": {"k": shape, "k_std": 0.044, "axes": ""}})
+        return bias, scale
+
+    bias, scale = pair(0.166)
+    w = np.array([1 / 0.032 ** 2, 1 / 0.044 ** 2])
+    k_exc, se_exc = float(np.dot(w, [0.066, 0.166]) / w.sum()), 1 / np.sqrt(w.sum())
+    assert excursion_scale(scale) == pytest.approx((k_exc, se_exc))
+    scale_read_as_bias([bias, scale], p)
+    x_true = 0.0474 - 0.0043
+    k_off, se_off = 0.0043 / x_true, 0.00025 / x_true
+    w = np.array([1 / se_off ** 2, 1 / se_exc ** 2])
+    assert scale.selected and not bias.selected and bias.details["read_as"] == "scale_alpha"
+    assert scale.estimate == pytest.approx(float(np.dot(w, [k_off, k_exc]) / w.sum()))
+    assert scale.details["offset"]["excursion_k"] == pytest.approx(k_exc)
+    assert scale.details["corroboration"] == {"named": True, "kinematic": 0.066, "kinematic_std": 0.032}
+    for shape in (None, -0.166):
+        bias, scale = pair(shape)
+        scale_read_as_bias([bias, scale], p)
+        assert not scale.selected and not bias.selected and "read_as" not in bias.details
+
+
 def test_a_scale_named_on_its_offset_is_tested_the_same_way_on_the_validation_maneuver():
     """validation._offset_scale_check: a scale named on its offset and excursions together is
     confirmed where the validation maneuver's offset (read as k = b/x̄_true, 0.12 ± 0.013)

@@ -80,7 +80,10 @@ def withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: Step
     no single coefficient error does. The kinematics cannot always see the scale (its
     column is nearly a bias's when the angle hardly moves about its mean). Not for β when the
     model follows the inertial sideslip (``inertial``): a vane scale cannot reach the mismatch
-    then. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing."""
+    then. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing. The
+    common k (its error scaled by the axes' scatter, :func:`birge_scaled`) is kept on the scale's
+    candidate (``details['shape']``): a reading of the vane's excursions independent of the
+    kinematics, which :func:`sensor_rules.scale_read_as_bias` sets beside the offset."""
     for x in ("alpha",) + (() if inertial else ("beta",)):
         name = f"scale_{x}"
         chosen = [c for c in cands if c.selected and c.effect == "coefficient_error"
@@ -96,11 +99,15 @@ def withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: Step
             for c in chosen:
                 c.details["vane_scale_refuted"] = refuted
             continue
+        each = ", ".join(f"{a.axis} {a.ratio * PROBE_SCALE:.3f} ± {a.std_error * PROBE_SCALE:.3f}"
+                         for a in ag.axes)
+        scale = next((c for c in cands if c.parameter == name), None)
+        if scale is not None:  # the excursions' reading, for sensor_rules.scale_read_as_bias
+            scale.details["shape"] = {"k": ag.ratio * PROBE_SCALE, "k_std": birge_scaled(ag) * PROBE_SCALE,
+                                      "axes": each}
         for c in chosen:
             c.selected = False
             c.details["sensor_rival"] = name
-            each = ", ".join(f"{a.axis} {a.ratio * PROBE_SCALE:.3f} ± {a.std_error * PROBE_SCALE:.3f}"
-                             for a in ag.axes)
             c.reason = (f"entered, but not named: an {x} vane scale error of k = {ag.ratio * PROBE_SCALE:.3f} would "
                         f"explain the mismatch on every axis that can tell alike (k from {each}), in the model's own "
                         "proportions, which a wrong derivative on one axis does not")

@@ -61,20 +61,28 @@ OFFSET_SCALE_CHANNELS = ("alpha", "V")
 
 
 def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
-    """Rename a named bias of α or V that is a scale factor's offset. A reading (1 + k)·x
-    stands k·x̄ off at the maneuver's mean x̄, which the kinematic fit (a bias always in it)
-    or the coefficient means along the vane give as a bias b, and moves k times the
-    excursions, which the kinematic fit gives as the scale k. When that k is named or
-    suspect (|t| >= :data:`AMBIGUOUS_T`) and the two say the same scale — k and b/x̄_true
-    within two standard errors of their difference — the finding is the scale, sized as
-    their inverse-variance mean, and the bias is read as its offset. A true bias leaves k
-    near zero. (An F-16 at 20,000 ft and 450 ft/s with a 10 % α-vane scale was named a 0.63°
-    α bias, b/x̄ = 0.100 ± 0.008 against k = 0.086 ± 0.022; at 427.4 ft/s the means named a
-    0.47° bias ahead of the scale the kinematics had named.) A scale the kinematics had not
-    named is judged on the validation maneuver as a finding named on two tests
-    (``details['corroboration']``: its kinematic k, same sign, |t| >= 2, within two standard
-    errors). Every bias of α or V carries its reading as a scale, b/x̄_true
-    (``details['as_scale']``), for that validation test (``validation._offset_scale_check``)."""
+    """Rename a bias of α or V that is a scale factor's offset. A reading (1 + k)·x stands
+    k·x̄ off at the maneuver's mean x̄, which the kinematic fit (a bias always in it) or the
+    coefficient means along the vane give as a bias b, and moves k times the excursions,
+    which the kinematic fit gives as the scale k, and the coefficient mismatch, for a vane, as
+    the model's own slopes times k on every axis that can tell (``details['shape']``,
+    :func:`sensor_naming.withhold_vane_scale`). When the excursions suggest a scale (the
+    kinematic |t| >= :data:`AMBIGUOUS_T`, or the mismatch's shape) and the offset says the
+    same scale — k and b/x̄_true within two standard errors of their difference — the
+    finding is the scale, sized as the inverse-variance mean of the offset's and the
+    excursions' readings (:func:`excursion_scale`), and the bias is read as its offset. A
+    true bias leaves k near zero. The bias must be named, or, when the mismatch's shape
+    reads the excursions, significant (|t| >= the kinematic entry t): read as a scale it
+    need not be a practical bias. (An F-16 at 20,000 ft and 450 ft/s with a 10 % α-vane
+    scale was named a 0.63° α bias, b/x̄ = 0.100 ± 0.008 against k = 0.086 ± 0.022; at
+    427.4 ft/s the means named a 0.47° bias ahead of the scale the kinematics had named. At
+    25,000 ft and 700 ft/s an 8 % scale left a 0.25° bias, t 17, under the bias's practical
+    size, the kinematic k at 0.066 ± 0.032 and the shape at 0.166 ± 0.044; nothing was
+    named.) A scale the kinematics had not named is judged on the validation maneuver as a
+    finding named on two tests (``details['corroboration']``: its kinematic k, same sign,
+    |t| >= 2, within two standard errors). Every bias of α or V carries its reading as a
+    scale, b/x̄_true (``details['as_scale']``), for that validation test
+    (``validation._offset_scale_check``)."""
     for channel in OFFSET_SCALE_CHANNELS:
         biases = [c for c in cands if c.parameter == f"bias_{channel}"]
         bias = next((c for c in biases if c.selected), biases[0] if biases else None)
@@ -86,27 +94,46 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
             continue
         k_off, se_off = bias.estimate / x_true, bias.std_error / abs(x_true)
         bias.details["as_scale"] = {"k": k_off, "k_std": se_off, "mean_true": x_true}
-        if not bias.selected or scale is None or abs(scale.t) < AMBIGUOUS_T:
+        if scale is None:
+            continue
+        shape = scale.details.get("shape")
+        offset_read = bias.selected or (shape is not None and abs(bias.t) >= KIN_T_IN)
+        if not offset_read or (abs(scale.t) < AMBIGUOUS_T and shape is None):
             continue
         V_mean = float(np.mean(p.smooth["V"]))
-        if np.sign(k_off) != np.sign(scale.estimate) or \
-                abs(k_off - scale.estimate) > 2.0 * np.hypot(se_off, scale.std_error):
-            _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, V_mean)
+        k_exc, se_exc = excursion_scale(scale)
+        if np.sign(k_off) != np.sign(k_exc) or abs(k_off - k_exc) > 2.0 * np.hypot(se_off, se_exc):
+            if bias.selected:
+                _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, V_mean)
             continue
-        k_exc, se_exc, named = scale.estimate, scale.std_error, scale.selected
         k, se = inverse_variance_mean([k_off, k_exc], [se_off, se_exc])
         if not (is_plausible(scale.parameter, k, V_mean) and is_practical(scale.parameter, k, p.dt)):
             continue
+        kin_k, kin_se, named = scale.estimate, scale.std_error, scale.selected
         scale.estimate, scale.std_error, scale.t, scale.selected = k, se, k / se, True
+        words = f"k = {k_exc:.3f} ± {se_exc:.3f}" + (
+            f": the kinematics {kin_k:.3f} ± {kin_se:.3f}, the mismatch's shape {shape['k']:.3f} ± "
+            f"{shape['k_std']:.3f}" if shape is not None else "")
         scale.reason = (f"the offset at the mean {channel} (a bias of {bias.estimate:.4g}: k = {k_off:.3f} ± "
-                        f"{se_off:.3f}) and the excursions (k = {k_exc:.3f} ± {se_exc:.3f}) agree on a scale factor")
+                        f"{se_off:.3f}) and the excursions ({words}) agree on a scale factor")
         scale.details["offset"] = {"bias": bias.estimate, "bias_std": bias.std_error, "mean_true": x_true,
                                    "k": k_off, "k_std": se_off, "excursion_k": k_exc, "excursion_k_std": se_exc}
         if not named:  # the kinematics alone had not named it: judged as named on two tests
-            scale.details["corroboration"] = {"named": True, "kinematic": k_exc, "kinematic_std": se_exc}
+            scale.details["corroboration"] = {"named": True, "kinematic": kin_k, "kinematic_std": kin_se}
         bias.selected = False
         bias.details["read_as"] = scale.parameter
         bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
+
+
+def excursion_scale(scale: Candidate) -> tuple[float, float]:
+    """A scale factor as the excursions read it: the kinematic estimate, combined (inverse
+    variance) with the coefficient mismatch's shape along the vane when that was read
+    (``details['shape']``, :func:`sensor_naming.withhold_vane_scale`); the two rest on
+    independent data (the inertial channels' kinematics, the measured coefficients)."""
+    shape = scale.details.get("shape")
+    if shape is None or not scale.std_error > 0:
+        return scale.estimate, scale.std_error
+    return inverse_variance_mean([scale.estimate, shape["k"]], [scale.std_error, shape["k_std"]])
 
 
 def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: float, se_off: float,

@@ -11,6 +11,7 @@ from harness.diagnosis.corroborate import inverse_variance_mean
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import MEANS_TESTS
+from harness.diagnosis.sensor_rules import excursion_scale
 
 
 def after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
@@ -247,7 +248,8 @@ def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | N
     """A scale factor named on its offset and its excursions together
     (:func:`sensor_rules.scale_read_as_bias`), tested the same way on the validation maneuver:
     there too the offset at the mean (its bias read as k = b/x̄_true) and the excursions
-    (the kinematic k, ``twin``) must agree within two standard errors; their
+    (the kinematic k, ``twin``, with the mismatch's shape where read:
+    :func:`sensor_rules.excursion_scale`) must agree within two standard errors; their
     inverse-variance mean is then the validation maneuver's estimate, judged as any sensor
     finding's (:func:`_same_instrument_status`). None when they disagree or there is no
     offset reading. (An F-16 at 22,000 ft and 600 ft/s with a 10 % α-vane scale: named at
@@ -259,12 +261,13 @@ def _offset_scale_check(av: Analysis, f: Candidate, twin: Candidate) -> dict | N
     if reading is None or not twin.std_error > 0:
         return None
     k_off, se_off = reading["k"], reading["k_std"]
-    if abs(k_off - twin.estimate) > 2.0 * np.hypot(se_off, twin.std_error):
+    k_exc, se_exc = excursion_scale(twin)
+    if abs(k_off - k_exc) > 2.0 * np.hypot(se_off, se_exc):
         return None
-    k, se = inverse_variance_mean([k_off, twin.estimate], [se_off, twin.std_error])
+    k, se = inverse_variance_mean([k_off, k_exc], [se_off, se_exc])
     return {"status": _same_instrument_status(k, k / se, f.estimate), "axes": [], "estimate": k, "std_error": se,
             "t": k / se, "rule": f"the offset at the mean {channel} (k = {k_off:.3f} ± {se_off:.3f}) and the "
-            f"excursions (k = {twin.estimate:.3f} ± {twin.std_error:.3f}) agree"}
+            f"excursions (k = {k_exc:.3f} ± {se_exc:.3f}) agree"}
 
 
 def _vane_means_check(av: Analysis, f: Candidate) -> dict:
