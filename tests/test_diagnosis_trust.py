@@ -377,6 +377,24 @@ def test_surfaces_not_recorded_are_named_with_what_stood_in_for_them():
     assert "surfaces not recorded" not in {a["item"] for a in _stand_ins(everything, {}, ())}
 
 
+def test_the_angular_accelerations_the_moments_use_are_stated():
+    """prepare._stand_ins: the moment coefficients always take the derivative of the
+    common-filtered rates; recorded pdot/qdot/rdot are said to be unused for them (all three
+    only carry a declared accelerometer position to the c.g.), and without them the
+    derivative is named as the stand-in."""
+    import numpy as np
+
+    from harness.diagnosis.prepare import _stand_ins
+    raw = {c: np.zeros(3) for c in ("de", "da", "dr", "thrust")}
+    item = {a["item"]: a for a in _stand_ins(raw, {}, ())}["angular accelerations"]
+    assert item["missing"] == "pdot, qdot, rdot channels" and "common-filtered rates" in item["stood_in_by"]
+    item = {a["item"]: a for a in _stand_ins(raw, {}, ("pdot_rps2", "qdot_rps2", "rdot_rps2"))}["angular accelerations"]
+    assert item["missing"] == "-" and "pdot, qdot, rdot are not used" in item["stood_in_by"]
+    assert "accelerometer position" in item["stood_in_by"]
+    item = {a["item"]: a for a in _stand_ins(raw, {}, ("qdot_rps2",))}["angular accelerations"]
+    assert "qdot are not used" in item["stood_in_by"] and "accelerometer" not in item["stood_in_by"]
+
+
 def test_a_beta_vane_bias_is_named_from_the_lateral_coefficient_means(tmp_path):
     """sensor_naming.name_vane_bias_from_means on the project sweep's β-vane bias of 1° (1.05° in
     the recording with the noise layer's own 0.05°): the kinematics hardly see it (t 1.5),

@@ -623,7 +623,7 @@ def write_case(c: OutsideCase, out_dir: str | Path) -> dict[str, Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
     cond = c.condition
     label = {"f16": "F-16", "737": "Boeing 737", "c172x": "Cessna 172 (JSBSim c172x)",
-             "dhc6": "DHC-6 Twin Otter"}[cond.aircraft]
+             "dhc6": "DHC-6 Twin Otter"}.get(cond.aircraft, cond.aircraft)
     paths, answers = {}, {}
     cv = c.convention
     noise = flight_test_noise(cv.white_scale, cv.gauss_markov_deg, cv.gauss_markov_tau_s)

@@ -393,7 +393,25 @@ def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...])
     out.append({"item": "angular rates", "missing": "-",
                 "stood_in_by": "p, q, r taken as the body rates the aerodynamics see (still air; inertial and "
                                "Earth-relative rates differ by at most 7.3e-5 rad/s)"})
+    out.append(_angular_accelerations_stand_in(columns))
     return out
+
+
+def _angular_accelerations_stand_in(columns: tuple[str, ...]) -> dict:
+    """How the moment coefficients get ṗ, q̇, ṙ (seed Eqs. 3-5): always the derivative of
+    the common-filtered rates (seed §III.A, method 2), so that every channel of the
+    coefficients passes one linear filter; recorded pdot/qdot/rdot, when present, serve only
+    to carry a declared accelerometer position to the c.g. (:func:`angular_accelerations`),
+    and the output says so."""
+    recorded = [f"{c}dot" for c in "pqr" if f"{c}dot_rps2" in columns]
+    if recorded:
+        return {"item": "angular accelerations", "missing": "-",
+                "stood_in_by": f"the recorded {', '.join(recorded)} are not used for the moment coefficients: "
+                               "the derivative of the common-filtered rates is (one filter for every channel)"
+                               + ("; they serve only to carry a declared accelerometer position to the c.g."
+                                  if len(recorded) == 3 else "")}
+    return {"item": "angular accelerations", "missing": "pdot, qdot, rdot channels",
+            "stood_in_by": "the derivative of the common-filtered rates (seed §III.A, method 2)"}
 
 
 def filtered_noise_std(noise_std: float, weights: np.ndarray) -> float:
