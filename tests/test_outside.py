@@ -116,7 +116,7 @@ def test_outside_gyros_add_earth_rate_like_jsbsim(tmp_path):
     latitude, taken at the end, drifts over the flight)."""
     import pandas as pd
 
-    from harness.diagnosis.outside import EARTH_RATE_RPS, inertial_gyros
+    from harness.diagnosis.outside_recording import EARTH_RATE_RPS, inertial_gyros
     got = independent_f16_recording(tmp_path / "r.csv", duration_s=4.0)
     rel, att = got["earth_relative"], got["attitude"]
     data = pd.DataFrame({"p_rps": rel[:, 0], "q_rps": rel[:, 1], "r_rps": rel[:, 2], "phi_rad": att[:, 0],
@@ -129,8 +129,9 @@ def test_outside_gyros_add_earth_rate_like_jsbsim(tmp_path):
 def test_outside_recording_pipeline(tmp_path):
     """Actuator flown and recorded, inertial gyros, values to 8 significant digits, channels
     dropped, the answer out of the recording."""
-    from harness.diagnosis.outside import (CONDITIONS, EARTH_RATE_RPS, Actuated, flight_test_noise, maneuvers,
-                                           postprocess, round_significant)
+    from harness.diagnosis.outside_cases import CONDITIONS, maneuvers
+    from harness.diagnosis.outside_recording import (EARTH_RATE_RPS, Actuated, flight_test_noise, postprocess,
+                                                     round_significant)
     from harness.noise import apply_noise
     from maneuvers.fly import FlightSpec, fly_maneuver
     from maneuvers.recording import Recording
@@ -180,7 +181,8 @@ def test_a_vane_bias_the_kinematics_only_suspect_is_named_on_two_tests(tmp_path)
     """Outside case F_pitch (1.5 deg alpha bias at the flap switch, no h channel): the
     kinematics alone see it at |t| ~ 3 (below their entry), the coefficient mismatch shows the
     same bias on C_X and C_m; named, with no other finding, its size within 25 %."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "F_pitch_sensor_bias_bias_alpha_0.0261799")
     row = run_case(c, tmp_path)
     assert row["error"] is None
@@ -201,7 +203,8 @@ def test_an_alpha_scale_the_kinematics_cannot_tell_from_an_az_skew_is_not_misnam
 def test_a_yaw_gyro_bias_is_seen_through_the_heading(tmp_path):
     """Outside case F_lateral (0.5 deg/s r bias): in the v equation an r bias (−R·u) is one
     column with an a_y bias; the heading equation (psi-dot) sees the yaw gyro directly."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "F_lateral_sensor_bias_bias_r_0.5deg")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -212,7 +215,8 @@ def test_a_small_drift_improves_the_validation_fit_once_the_replay_fits_its_leve
     the potentiometer noise) drifts the replay through its phugoid by more than the drift term
     changes it; with each replay's surface levels fitted, the augmented model's validation
     RMS in q drops by at least 30 % (criterion d), and the levels are reported."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "F_pitch_flight_condition_drift_Cm_dV_0.02")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -227,7 +231,8 @@ def test_a_gyro_skew_no_coefficient_term_imitates_is_named_on_two_tests(tmp_path
     |t| ~ 3.7 only, and it kept no coefficient term from being named; every kinematic suspect
     in 2.5 <= t < 6 is still put to the coefficient mismatch, which shows the same skew on
     the axes that can tell: named, size within 25 %, nothing else."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "H_lateral_sensor_time_skew_skew_p_0.04")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -239,7 +244,8 @@ def test_a_beta_vane_scale_is_corroborated_along_the_vane(tmp_path):
     r-gyro scale at -5.4; along the inertial sideslip the model never sees the vane, so the
     vane's signature is taken along the vane itself: C_Y, C_l and C_n agree on it and it is
     named (size within 25 %), the gyro scale is not."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "S_lateral_sensor_scale_scale_beta_0.15")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -252,7 +258,8 @@ def test_a_spiral_after_a_lateral_input_makes_no_finding_of_its_own(tmp_path):
     levels with the stabilator still: the model is evaluated along them, but no term is built
     on them (held at their start, C_m's mismatch stood at 11 times its noise and a C_m,ΔV
     "finding" entered at t = 42). The delay is named, nothing else."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "D_lateral_control_delay_tau_da_0.06")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -263,7 +270,8 @@ def test_the_twin_otter_self_check_gives_none(tmp_path):
     -1.66 ± 0.29 per rad² from the propeller torque's change with airspeed in the spiral; the
     calibration in the loop sizes it -0.017 ± 0.015 and it is withdrawn, listed as
     'unsupported' in not_confirmed."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "selfcheck_dhc6_D")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["first"]["effect"] == "none" and row["c"] == 0, row["findings"]
@@ -277,7 +285,8 @@ def test_other_conventions_read_back_as_written(tmp_path):
     own unit table) to the canonical values; the multisine and sweep styles drive the kind's
     surfaces, the validation maneuver stays the multi-step one; Convention names only what
     departs from the usual recording."""
-    from harness.diagnosis.outside import CONDITIONS, OTHER_UNITS, Convention, maneuvers, rewrite_in_units
+    from harness.diagnosis.outside_cases import CONDITIONS, Convention, maneuvers
+    from harness.diagnosis.outside_recording import OTHER_UNITS, rewrite_in_units
     from harness.recording_io import read_recording, write_recording
     from maneuvers.fly import FlightSpec, fly_maneuver
     from models.aircraft import Aircraft
@@ -309,7 +318,8 @@ def test_an_accelerometer_away_from_the_cg_and_declared_comes_back_to_it():
     import numpy as np
     import pandas as pd
 
-    from harness.diagnosis.outside import Convention, accelerometer_away
+    from harness.diagnosis.outside_cases import Convention
+    from harness.diagnosis.outside_recording import accelerometer_away
     from harness.diagnosis.prepare import accelerometer_to_cg
     from maneuvers.recording import Recording
     t = np.arange(200) * 0.02
@@ -331,7 +341,8 @@ def test_light_turbulence_on_a_slow_aircraft_is_named_as_air(name, tmp_path):
     noise: under the light-gust angle), Dryden severity 2: the C_Z mismatch carries none of
     the vane-against-inertial difference (the aircraft flew the vane's angle), so the gust
     is air: named light turbulence, nothing else, its air share in the evidence."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == name)
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["c"] == 0, row["first"]
@@ -346,7 +357,8 @@ def test_vanes_wandering_as_far_as_gusts_are_not_turbulence(tmp_path):
     named turbulence before the air-share test, and C_Z,α −2.47 once it did not. The
     aerodynamics did not follow the vanes: `none`, and not_checked says why α terms were
     not offered."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "H_pitch_none_vanewander0.4deg")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["c"] == 0, row["findings"]
@@ -365,7 +377,8 @@ def test_a_c172x_alpha_vane_bias_is_named_from_the_longitudinal_coefficient_mean
     the validation maneuver shows it too. Size within 2 standard errors or 5 %."""
     import math
 
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "C1_pitch_sensor_bias_bias_alpha_0.0174533")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -381,7 +394,8 @@ def test_a_c172x_moment_drift_is_named_once_the_vane_noise_leaves_cm(tmp_path):
     passed through the model's C_m,α, was a third of C_m's mismatch and hid the drift; with
     the vane-noise column in C_m's fit (stepwise_axes.vane_noise_columns) it is named, its size
     within 25 %, nothing else named."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "C1_three_axis_flight_condition_drift_Cm_dV_0.02")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
@@ -393,7 +407,8 @@ def test_a_c172x_moment_reference_shift_is_sized_by_the_mistrim_of_cm(tmp_path):
     C_m's constant, the mistrim Δx·mean(C_Z)/c̄ a shift makes, refutes that size and names
     the one it says (stepwise_axes._cg_mean_test): within 2 standard errors or 25 % of 0.25 ft,
     nothing else named, the validation's q fit better by 30 % or more."""
-    from harness.diagnosis.outside import cases, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "C2_three_axis_cg_offset_dx_moment_reference_0.25")
     row = run_case(c, tmp_path)
     assert row["error"] is None and row["a"] and row["b"] and row["d"] and row["c"] == 0, row["first"]
@@ -412,7 +427,8 @@ def test_an_alpha_scale_at_the_flap_switch_is_named_alone(tmp_path):
     2 standard errors or 25 %."""
     from dataclasses import replace
 
-    from harness.diagnosis.outside import H, OutsideCase, _drops, run_case
+    from harness.diagnosis.outside import run_case
+    from harness.diagnosis.outside_cases import H, OutsideCase, _drops
     c = replace(OutsideCase("F_pitch_sensor_scale_scale_alpha_s2106", "F", "pitch",
                             (H("sensor_scale", 0.1, channel="alpha"),), "sensor_scale", "scale_alpha", 0.1, "alpha",
                             seed=2106), drop=_drops(2106))
