@@ -638,6 +638,42 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     assert bias.details["as_scale"]["k"] == pytest.approx(0.1)  # the reading the validation test uses
 
 
+def test_a_vane_scale_is_read_on_the_axes_the_vane_reaches():
+    """sensor_naming.withhold_vane_scale: an α-vane scale reaches the longitudinal axes
+    through the model's slopes (C_X, C_Z, C_m agree here on k = 0.087); a C_l mismatch on a
+    pitch maneuver that follows the signature ten times harder (22 ± 1.2 probe units) is not
+    a witness (the α dependence of the lateral moments runs through β), so the shape is read
+    and kept on the scale (details['shape']) — also where the term was withheld already for
+    that scale (details['sensor_rival']), which it then leaves as it was."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.corroborate import AxisRatio
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_naming import PROBE_SCALE, withhold_vane_scale
+    ratios = {"CX": AxisRatio("", 1.18, 0.50), "CZ": AxisRatio("", 1.66, 0.28), "Cm": AxisRatio("", 1.83, 0.165),
+              "Cl": AxisRatio("", 22.1, 1.15), "CY": AxisRatio("", -49.0, 133.0), "Cn": AxisRatio("", -3.2, 25.0)}
+    kin = SimpleNamespace(parameters={"scale_alpha": None},
+                          selection=SimpleNamespace(params={}, terms=[SimpleNamespace(name="scale_alpha",
+                                                                                      estimate=0.072, t=5.9)]))
+
+    def run(withheld):
+        term = Candidate("coefficient_error", "lon", "CZ", "CZ_alpha", -3.34, 0.5, 5.9, 0.1, "per rad",
+                         "stepwise on the CZ mismatch", not withheld, "entered",
+                         {"sensor_rival": "scale_alpha"} if withheld else {})
+        scale = Candidate("sensor_scale", None, "alpha", "scale_alpha", 0.072, 0.012, 5.9, 0.0, "1",
+                          "kinematic consistency", False, "below the entry t")
+        withhold_vane_scale([term, scale], kin, None, lambda name, size, same: ratios)
+        return term, scale
+
+    term, scale = run(False)
+    w = 1 / np.array([0.50, 0.28, 0.165]) ** 2
+    k = PROBE_SCALE * float(np.dot(w, [1.18, 1.66, 1.83]) / w.sum())
+    assert not term.selected and term.details["sensor_rival"] == "scale_alpha"
+    assert scale.details["shape"]["k"] == pytest.approx(k)
+    term, scale = run(True)
+    assert scale.details["shape"]["k"] == pytest.approx(k) and term.reason == "entered"
+
+
 def test_the_mismatchs_shape_reads_a_vane_scales_excursions_beside_its_offset():
     """sensor_rules.scale_read_as_bias with the coefficient mismatch's shape along the vane
     (details['shape'], sensor_naming.withhold_vane_scale): the excursions are read as the

@@ -80,18 +80,27 @@ def withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: Step
     no single coefficient error does. The kinematics cannot always see the scale (its
     column is nearly a bias's when the angle hardly moves about its mean). Not for β when the
     model follows the inertial sideslip (``inertial``): a vane scale cannot reach the mismatch
-    then. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing. The
+    then. The axes asked are those the vane reaches through the model's slopes
+    (:data:`VANE_MEANS_AXES`: C_X, C_Z, C_m for α; C_Y, C_l, C_n for β), as for its bias: on a
+    pitch multisine at 420 ft/s with a 10 % α scale, C_l followed the α-scale signature 22 ±
+    1.2 times (its α dependence runs through β, which hardly moved) and vetoed the agreement of
+    C_X, C_Z and C_m on k = 0.087. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing. The
     common k (its error scaled by the axes' scatter, :func:`birge_scaled`) is kept on the scale's
     candidate (``details['shape']``): a reading of the vane's excursions independent of the
-    kinematics, which :func:`sensor_rules.scale_read_as_bias` sets beside the offset."""
+    kinematics, which :func:`sensor_rules.scale_read_as_bias` sets beside the offset. It is
+    read too where the term was withheld already because the kinematics suspect that scale
+    (``details['sensor_rival']``, :func:`term_rules.withhold_ambiguous`)."""
     for x in ("alpha",) + (() if inertial else ("beta",)):
         name = f"scale_{x}"
-        chosen = [c for c in cands if c.selected and c.effect == "coefficient_error"
-                  and cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1]) == x]
-        if not chosen or name not in kin.parameters:
+        on_x = [c for c in cands if c.effect == "coefficient_error"
+                and cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1]) == x]
+        chosen = [c for c in on_x if c.selected]
+        # a term withheld already for this scale (the kinematics suspect it) is read the same way
+        if not (chosen or any(c.details.get("sensor_rival") == name for c in on_x)) or name not in kin.parameters:
             continue
         same = frozenset(c.parameter for c in cands if c.parameter.endswith(f"_{x}") and c.test.startswith("stepwise"))
-        ag = corroborate.imitates(signature(name, PROBE_SCALE, same), t_aero=cand.T_IN)
+        ratios = {k: r for k, r in signature(name, PROBE_SCALE, same).items() if k in VANE_MEANS_AXES[x]}
+        ag = corroborate.imitates(ratios, t_aero=cand.T_IN)
         if ag is None or not is_plausible(name, ag.ratio * PROBE_SCALE, 1.0):
             continue
         refuted = kinematics_refute(kin, name, ag.ratio * PROBE_SCALE, ag.std_error * PROBE_SCALE)
