@@ -317,6 +317,48 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
         assert name_replicated(a, analysis(v, se)) == [] and not a.candidates[0].selected
 
 
+def test_a_sensor_suspicion_the_validation_maneuver_does_not_share_is_lifted(monkeypatch):
+    """sensor_naming.lift_unreplicated_suspicions: a C_n,β term withheld because the
+    identification's kinematics suspected an r-gyro scale of 0.088 ± 0.028 (t 3.2) is named
+    again when the validation maneuver's kinematics put that scale at −0.055 ± 0.022 (4.0
+    combined standard errors apart; a suspicion of the other sign there). A validation
+    estimate of the same sign that is a suspicion itself, one within two standard errors, one
+    the validation maneuver cannot measure, a term withheld for another reason, or a scale the
+    coefficient mismatch itself reads (details['shape']) lift nothing."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis import sensor_naming
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_naming import lift_unreplicated_suspicions
+    monkeypatch.setattr(sensor_naming, "_kinematics_trusted", lambda a: True)
+
+    def kin(v, t):
+        return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[
+            SimpleNamespace(name="scale_r", estimate=v, t=t, std_error=abs(v) / t)]))
+
+    def identification(details=None, shape=False):
+        term = Candidate("coefficient_error", "yaw", "Cn", "Cn_beta", 0.257, 0.003, 11.7, 0.3, "per rad",
+                         "stepwise on the Cn mismatch", False, "entered, but not named: ...",
+                         details if details is not None else {"sensor_rival": "scale_r",
+                                                              "suspicion": {"parameter": "scale_r", "t": 3.16}})
+        scale = Candidate("sensor_scale", None, "r", "scale_r", 0.088, 0.028, 3.16, 0.0, "1",
+                          "kinematic consistency", False, "below the entry t",
+                          {"shape": {"k": 0.09, "k_std": 0.02}} if shape else {})
+        return SimpleNamespace(candidates=[term, scale], kinematic=kin(0.088, 3.16))
+
+    a = identification()
+    assert lift_unreplicated_suspicions(a, SimpleNamespace(kinematic=kin(-0.0548, 2.52))) == [a.candidates[0]]
+    assert a.candidates[0].selected and "suspicion is lifted" in a.candidates[0].reason
+    assert a.candidates[0].details["suspicion_lifted"]["validation"][0] == pytest.approx(-0.0548)
+    for there in (kin(0.05, 2.6),    # the same sign, a suspicion there too
+                  kin(0.04, 1.8),    # (0.088 - 0.04) / hypot(0.028, 0.022) = 1.4: within two
+                  kin(0.01, 0.05)):  # the validation cannot measure it (0.2 standard error)
+        a = identification()
+        assert lift_unreplicated_suspicions(a, SimpleNamespace(kinematic=there)) == [] and not a.candidates[0].selected
+    for a in (identification(details={"sensor_rival": "scale_r"}), identification(shape=True)):
+        assert lift_unreplicated_suspicions(a, SimpleNamespace(kinematic=kin(-0.0548, 2.52))) == []
+
+
 def test_an_accelerometer_offset_is_explained_along_its_own_axis():
     """verdict._offset_direction: a lateral offset is 'right of' or 'left of' the c.g. (y), a
     vertical one 'below' or 'above' (z, body axes down), the force fit's x 'ahead of'."""

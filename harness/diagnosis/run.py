@@ -15,7 +15,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
                                          write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import instruments_at_cg, prepare
-from harness.diagnosis.sensor_naming import name_replicated
+from harness.diagnosis.sensor_naming import lift_unreplicated_suspicions, name_replicated
 from harness.diagnosis.validation import undecided, validation_check
 from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, chosen_findings,
                                        excited_axes, finding_dict, focus_axis, located_paragraph, none_finding,
@@ -143,8 +143,9 @@ def _checked(a: Analysis, av: Analysis | None) -> tuple[list[Candidate], list[Ca
     """The findings kept, those reported apart, and each one's validation check. A finding
     is kept only when the validation maneuver confirms it (or cannot test it: a gust level, a
     spectral peak, a coupling it does not excite, :func:`validation.untestable`)."""
-    if av is not None:  # sensor biases each maneuver only suspects, named on the two
-        name_replicated(a, av)
+    if av is not None:  # sensor biases each maneuver only suspects, named on the two; and
+        name_replicated(a, av)  # terms withheld for a sensor suspicion the validation does not share
+        lift_unreplicated_suspicions(a, av)
     findings = chosen_findings(a)
     checks = {id(f): validation_check(av, f) if av is not None else undecided(f) for f in findings}
     unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"]

@@ -17,7 +17,8 @@ from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_pract
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_estimate, kinematic_rival, kinematic_share,
-                                            kinematic_t, kinematics_plausible, kinematics_refute, sensor_verdict)
+                                            kinematic_std_error, kinematic_t, kinematics_plausible, kinematics_refute,
+                                            sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
 from models.aircraft import Aircraft
 from models.hidden import SENSOR_EFFECTS
@@ -374,6 +375,57 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
         c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
         named.append(c)
     return named
+
+
+# A sensor suspicion that withheld a term is lifted when the validation maneuver's kinematics
+# put the same parameter at least this many combined standard errors from the
+# identification's estimate (and do not suspect it themselves with the same sign).
+UNREPLICATED_Z = 2.0
+
+
+def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
+    """Name again the terms withheld only because the identification's kinematics suspected a
+    sensor error that would imitate them (``details['suspicion']``,
+    :func:`term_rules.withhold_ambiguous`), when the validation maneuver's kinematics rule
+    that error out: the same instrument flew both maneuvers, so an error it has shows in
+    both, while a suspicion at |t| 2.5-6 arises on null recordings too (noise, a vane's
+    wander). Lifted when the validation's estimate of the parameter lies at least
+    :data:`UNREPLICATED_Z` combined standard errors from the identification's and is not
+    itself a suspicion of the same sign (|t| >= :data:`AMBIGUOUS_T`); a validation maneuver
+    that cannot measure it (a large standard error) lifts nothing. Not when either record's kinematics are void
+    (:func:`_kinematics_trusted`), nor when the coefficient mismatch itself reads the
+    suspected vane scale (``details['shape']``, :func:`withhold_vane_scale`). The term is
+    then judged on the validation maneuver as any finding. (An F-16 at 330 ft/s, lateral,
+    C_n,β +0.04: entered at t 11.7 and withheld for an r-gyro scale of 0.088 ± 0.028, kinematic
+    t 3.2, which the validation maneuver put at −0.055 ± 0.022.)
+    Returns the candidates of ``a`` it selected."""
+    if not (_kinematics_trusted(a) and _kinematics_trusted(av)):
+        return []
+    by_name = {c.parameter: c for c in a.candidates}
+    lifted = []
+    for c in a.candidates:
+        suspicion = c.details.get("suspicion")
+        if c.selected or not suspicion or c.details.get("sensor_rival") != suspicion["parameter"]:
+            continue
+        name = suspicion["parameter"]
+        if "shape" in getattr(by_name.get(name), "details", {}):
+            continue
+        here, there = kinematic_estimate(a.kinematic, name), kinematic_estimate(av.kinematic, name)
+        if here is None or there is None or (there[1] >= AMBIGUOUS_T and np.sign(there[0]) == np.sign(here[0])):
+            continue
+        se_here, se_there = kinematic_std_error(a.kinematic, name), kinematic_std_error(av.kinematic, name)
+        apart = float(np.hypot(se_here, se_there))
+        if not (np.isfinite(apart) and apart > 0) or abs(here[0] - there[0]) < UNREPLICATED_Z * apart:
+            continue
+        c.details["suspicion_lifted"] = {"parameter": name, "identification": [here[0], se_here],
+                                         "validation": [there[0], se_there]}
+        c.reason = (f"entered; the kinematics suspected {name} ({here[0]:.3g} ± {se_here:.2g}, t = {here[1]:.1f}), "
+                    f"which would imitate it, but the validation maneuver's put it at {there[0]:.3g} ± "
+                    f"{se_there:.2g} (t = {there[1]:.1f}), {abs(here[0] - there[0]) / apart:.1f} standard errors "
+                    "apart: the same instrument flew both, so the suspicion is lifted")
+        c.selected = True
+        lifted.append(c)
+    return lifted
 
 
 def _kinematics_trusted(a: Analysis) -> bool:

@@ -321,7 +321,8 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
     channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
     kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
-    reason names the rival."""
+    reason names the rival, and ``details['suspicion']`` keeps it for the validation maneuver
+    (:func:`sensor_naming.lift_unreplicated_suspicions`)."""
 
     def explains(c: Candidate, rival: str, t: float) -> bool:
         if c.details.get("sensor_suspect", {}).get("parameter") == rival:
@@ -351,6 +352,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             rival, t = suspects[channel]
             c.selected = False
             c.details["sensor_rival"] = rival
+            c.details["suspicion"] = {"parameter": rival, "t": t}
             c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({rival}, "
                         f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
     for c in cands:  # the sensor the coefficient itself is measured with
@@ -365,5 +367,6 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             continue
         c.selected = False
         c.details["sensor_rival"] = rival
+        c.details["suspicion"] = {"parameter": rival, "t": t}
         c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
                     f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
