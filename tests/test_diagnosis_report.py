@@ -11,10 +11,11 @@ import pandas as pd
 import pytest
 
 from models.constants import BODY_COEFFICIENTS as COEFFICIENTS
-from reports.diagnosis_report import (affected_channels, affected_coefficients, diagnosis_report,
-                                      write_diagnosis_report)
+from reports.diagnosis_channels import affected_channels, affected_coefficients
+from reports.diagnosis_report import diagnosis_report, write_diagnosis_report
 from reports.html import html_text
-from reports.render import PNG_SIGNATURE, Report, format_number
+from reports.render import PNG_SIGNATURE, Report
+from reports.render_values import format_number
 
 CHANNELS = ("alpha", "beta", "p", "q", "r", "phi", "theta", "V", "ax", "ay", "az")
 IMG = re.compile(r'<img\s[^>]*src="([^"]*)"')

@@ -272,7 +272,7 @@ def test_the_kinematics_refute_a_vane_scale_they_do_not_see():
 
 
 def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypatch):
-    """sensor_naming.name_replicated: the same instrument flew both maneuvers, so an a_z bias the
+    """replication.name_replicated: the same instrument flew both maneuvers, so an a_z bias the
     identification's kinematics put at 0.027 ± 0.0058 (t 4.7) and the validation's at
     0.027 ± 0.0042 (t 6.3 there, but below the entry t on the identification) is named at
     their inverse-variance combination; opposite signs, sizes more than two standard errors
@@ -281,12 +281,12 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
     error is named."""
     from types import SimpleNamespace
 
-    from harness.diagnosis import sensor_naming
+    from harness.diagnosis import replication
     from harness.diagnosis.evidence import Candidate
-    from harness.diagnosis.sensor_naming import name_replicated
-    monkeypatch.setattr(sensor_naming, "_kinematics_trusted", lambda a: True)
-    monkeypatch.setattr(sensor_naming, "kinematic_rival", lambda kin, name: None)
-    monkeypatch.setattr(sensor_naming, "sensor_verdict", lambda *args: (True, ""))
+    from harness.diagnosis.replication import name_replicated
+    monkeypatch.setattr(replication, "_kinematics_trusted", lambda a: True)
+    monkeypatch.setattr(replication, "kinematic_rival", lambda kin, name: None)
+    monkeypatch.setattr(replication, "sensor_verdict", lambda *args: (True, ""))
 
     def analysis(v, se):
         c = Candidate("sensor_bias", None, "az", "bias_az", v, se, v / se, 0.0, "g", "kinematic consistency",
@@ -318,7 +318,7 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
 
 
 def test_a_sensor_suspicion_the_validation_maneuver_does_not_share_is_lifted(monkeypatch):
-    """sensor_naming.lift_unreplicated_suspicions: a C_n,β term withheld because the
+    """replication.lift_unreplicated_suspicions: a C_n,β term withheld because the
     identification's kinematics suspected an r-gyro scale of 0.088 ± 0.028 (t 3.2) is named
     again when the validation maneuver's kinematics put that scale at −0.055 ± 0.022 (4.0
     combined standard errors apart; a suspicion of the other sign there). A validation
@@ -327,10 +327,10 @@ def test_a_sensor_suspicion_the_validation_maneuver_does_not_share_is_lifted(mon
     coefficient mismatch itself reads (details['shape']) lift nothing."""
     from types import SimpleNamespace
 
-    from harness.diagnosis import sensor_naming
+    from harness.diagnosis import replication
     from harness.diagnosis.evidence import Candidate
-    from harness.diagnosis.sensor_naming import lift_unreplicated_suspicions
-    monkeypatch.setattr(sensor_naming, "_kinematics_trusted", lambda a: True)
+    from harness.diagnosis.replication import lift_unreplicated_suspicions
+    monkeypatch.setattr(replication, "_kinematics_trusted", lambda a: True)
 
     def kin(v, t):
         return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[

@@ -16,8 +16,9 @@ import pytest
 from reports.html import html_text, write_html
 from reports.jsonreport import write_json
 from reports.markdown import markdown_text, write_markdown
-from reports.render import (HTML_MAX_ROWS, MARKDOWN_MAX_ROWS, Report, Section, Table,
-                            anchors, format_number, jsonable, png_size)
+from reports.render import Report, Section, Table, anchors, png_size
+from reports.render_tables import HTML_MAX_ROWS, MARKDOWN_MAX_ROWS
+from reports.render_values import format_number, jsonable
 
 EVIL = "<script>document.body.dataset.pwned='yes'</script> & \"quotes\""
 

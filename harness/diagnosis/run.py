@@ -15,7 +15,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
                                          write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import instruments_at_cg, prepare
-from harness.diagnosis.sensor_naming import lift_unreplicated_suspicions, name_replicated
+from harness.diagnosis.replication import lift_unreplicated_suspicions, name_replicated
 from harness.diagnosis.validation import undecided, validation_check
 from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, chosen_findings,
                                        excited_axes, finding_dict, focus_axis, located_paragraph, none_finding,

@@ -114,7 +114,6 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
     column (:func:`vane_noise_columns`) where the model follows the vane; drift terms that
     thrust or a propeller would imitate are not offered."""
     selections, nuisances, not_offered, shares, pools = {}, {}, {}, {}, {}
-    inner = interior(p)
     for axis in COEFFICIENTS:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}

@@ -322,7 +322,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
     kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
     reason names the rival, and ``details['suspicion']`` keeps it for the validation maneuver
-    (:func:`sensor_naming.lift_unreplicated_suspicions`)."""
+    (:func:`replication.lift_unreplicated_suspicions`)."""
 
     def explains(c: Candidate, rival: str, t: float) -> bool:
         if c.details.get("sensor_suspect", {}).get("parameter") == rival:

@@ -220,7 +220,7 @@ def _sensor_check(av: Analysis, f: Candidate) -> dict:
     if "replication" in f.details:  # named on the two maneuvers' kinematics together
         v, sv = f.details["replication"]["validation"]
         return {"status": "confirmed", "axes": [], "estimate": float(v), "std_error": float(sv), "t": float(v / sv),
-                "rule": "named on both maneuvers' kinematics (sensor_naming.name_replicated)"}
+                "rule": "named on both maneuvers' kinematics (replication.name_replicated)"}
     twin = next((c for c in av.candidates if c.parameter == f.parameter), None)
     if twin is None:
         return {"status": "neutral", "axes": [], "estimate": None, "t": None,

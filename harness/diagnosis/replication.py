@@ -1,0 +1,128 @@
+"""Sensor findings replicated on both maneuvers: the same instrument flew the identification
+and the validation maneuver, so a sensor error shows in both records' kinematics, with
+independent noise. A bias each only suspects is named on the two together; a suspicion that
+withheld a coefficient term and that the validation maneuver does not share is lifted."""
+from __future__ import annotations
+
+import numpy as np
+
+from harness.diagnosis import corroborate
+from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_estimate, kinematic_rival, kinematic_std_error,
+                                            kinematics_plausible, sensor_verdict)
+from models.hidden import SENSOR_EFFECTS
+
+
+# The |t| each maneuver's kinematic estimate must reach on its own for a sensor error below
+# the identification's entry t to be named on the two together (:func:`name_replicated`):
+# the suspicion level of the other sensor rules (:data:`AMBIGUOUS_T`).
+REPLICATED_EACH_T = AMBIGUOUS_T
+
+
+def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
+    """Name the sensor biases that the identification's kinematics only suspect (|t| at least
+    :data:`REPLICATED_EACH_T`, below the entry t) and the validation's show too (|t| at least
+    as much, the same sign, sizes within two standard errors), when their inverse-variance
+    combination reaches the kinematic entry t (:data:`kinematics.T_IN`): the same instrument
+    flew both, and their kinematic residuals carry independent noise. Not when either record's
+    kinematics are void (turbulence, light gusts, implausible estimates), when the
+    identification's kinematics cannot tell the parameter from a rival
+    (:func:`kinematic_rival`), or when the combined size is not practical and precise
+    (:func:`sensor_verdict`). Returns the candidates of ``a`` it selected.
+
+    Biases only, and only when no other sensor error is named: the replication shows the two
+    records' noise to be independent, not their systematic errors. A real error the kinematic
+    fit leaves out repeats in both records and pushes the columns that follow the same motion
+    alike: beside a β-vane scale of 0.15 (named on the coefficient mismatch, not in the
+    kinematic fit) both maneuvers asked for an r-gyro scale of −0.14 (t −5.4 and −5.8), and a
+    noise-free DHC-6 flight of the model itself for an a_y scale of −0.07 (t −3.8 and −5.6;
+    outside sweep, 2 Dec 2026). A constant is the one column a motion-following error does
+    not imitate alike in two different maneuvers."""
+    if not (_kinematics_trusted(a) and _kinematics_trusted(av)):
+        return []
+    if any(c.selected and c.effect in SENSOR_EFFECTS for c in a.candidates):
+        return []
+    p, kin = a.prepared, a.kinematic
+    twins = {c.parameter: c for c in av.candidates if c.test.startswith("kinematic consistency")}
+    named = []
+    for c in a.candidates:
+        v = twins.get(c.parameter)
+        if (c.selected or v is None or c.reason != "below the entry t" or c.effect != "sensor_bias"
+                or min(abs(c.t), abs(v.t)) < REPLICATED_EACH_T or np.sign(c.estimate) != np.sign(v.estimate)
+                or c.std_error <= 0 or v.std_error <= 0):
+            continue
+        if abs(c.estimate - v.estimate) > 2.0 * np.hypot(c.std_error, v.std_error):
+            continue
+        est, se = corroborate.inverse_variance_mean([c.estimate, v.estimate], [c.std_error, v.std_error])
+        if abs(est) / se < KIN_T_IN or kinematic_rival(kin, c.parameter) is not None:
+            continue
+        if not sensor_verdict(c.parameter, est, se, True, kin, p, False, True)[0]:
+            continue
+        c.details["replication"] = {"identification": [c.estimate, c.std_error],
+                                    "validation": [v.estimate, v.std_error], "combined": [est, se]}
+        c.reason = (f"named on two maneuvers: the identification's kinematics suspect it (t = {c.t:.1f}, below "
+                    f"the entry t) and the validation's agree (t = {v.t:.1f}, the sizes within two standard "
+                    f"errors); together t = {est / se:.1f}")
+        c.selected, c.estimate, c.std_error, c.t = True, est, se, est / se
+        named.append(c)
+    return named
+
+
+# A sensor suspicion that withheld a term is lifted when the validation maneuver's kinematics
+# put the same parameter at least this many combined standard errors from the
+# identification's estimate (and do not suspect it themselves with the same sign).
+UNREPLICATED_Z = 2.0
+
+
+def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
+    """Name again the terms withheld only because the identification's kinematics suspected a
+    sensor error that would imitate them (``details['suspicion']``,
+    :func:`term_rules.withhold_ambiguous`), when the validation maneuver's kinematics rule
+    that error out: the same instrument flew both maneuvers, so an error it has shows in
+    both, while a suspicion at |t| 2.5-6 arises on null recordings too (noise, a vane's
+    wander). Lifted when the validation's estimate of the parameter lies at least
+    :data:`UNREPLICATED_Z` combined standard errors from the identification's and is not
+    itself a suspicion of the same sign (|t| >= :data:`AMBIGUOUS_T`); a validation maneuver
+    that cannot measure it (a large standard error) lifts nothing. Not when either record's kinematics are void
+    (:func:`_kinematics_trusted`), nor when the coefficient mismatch itself reads the
+    suspected vane scale (``details['shape']``, :func:`sensor_naming.withhold_vane_scale`). The term is
+    then judged on the validation maneuver as any finding. (An F-16 at 330 ft/s, lateral,
+    C_n,β +0.04: entered at t 11.7 and withheld for an r-gyro scale of 0.088 ± 0.028, kinematic
+    t 3.2, which the validation maneuver put at −0.055 ± 0.022.)
+    Returns the candidates of ``a`` it selected."""
+    if not (_kinematics_trusted(a) and _kinematics_trusted(av)):
+        return []
+    by_name = {c.parameter: c for c in a.candidates}
+    lifted = []
+    for c in a.candidates:
+        suspicion = c.details.get("suspicion")
+        if c.selected or not suspicion or c.details.get("sensor_rival") != suspicion["parameter"]:
+            continue
+        name = suspicion["parameter"]
+        if "shape" in getattr(by_name.get(name), "details", {}):
+            continue
+        here, there = kinematic_estimate(a.kinematic, name), kinematic_estimate(av.kinematic, name)
+        if here is None or there is None or (there[1] >= AMBIGUOUS_T and np.sign(there[0]) == np.sign(here[0])):
+            continue
+        se_here, se_there = kinematic_std_error(a.kinematic, name), kinematic_std_error(av.kinematic, name)
+        apart = float(np.hypot(se_here, se_there))
+        if not (np.isfinite(apart) and apart > 0) or abs(here[0] - there[0]) < UNREPLICATED_Z * apart:
+            continue
+        c.details["suspicion_lifted"] = {"parameter": name, "identification": [here[0], se_here],
+                                         "validation": [there[0], se_there]}
+        c.reason = (f"entered; the kinematics suspected {name} ({here[0]:.3g} ± {se_here:.2g}, t = {here[1]:.1f}), "
+                    f"which would imitate it, but the validation maneuver's put it at {there[0]:.3g} ± "
+                    f"{se_there:.2g} (t = {there[1]:.1f}), {abs(here[0] - there[0]) / apart:.1f} standard errors "
+                    "apart: the same instrument flew both, so the suspicion is lifted")
+        c.selected = True
+        lifted.append(c)
+    return lifted
+
+
+def _kinematics_trusted(a: Analysis) -> bool:
+    """Whether a recording's kinematic consistency can judge its sensors: no turbulence
+    named, no light gusts (:func:`light_gusts`), every supported estimate plausible."""
+    turbulent = any(c.effect == "turbulence" and c.selected for c in a.candidates)
+    V0 = float(np.mean(a.prepared.smooth["V"]))
+    return not turbulent and not a.gusty and kinematics_plausible(a.kinematic, V0)
