@@ -3,6 +3,7 @@
 - :mod:`reports.load`            read a campaign's output folder
 - :mod:`reports.figures`         the matplotlib figures (seed Figs. 1, 3-7 and more)
 - :mod:`reports.render`          the format-free document model
+- :mod:`reports.render_tables`, :mod:`reports.render_values`  tables as shown; numbers and provenance as text
 - :mod:`reports.html`, :mod:`reports.markdown`, :mod:`reports.jsonreport`  the three formats
 - :mod:`reports.campaign_report` any campaign's report (``sidbench report DIR``)
 - :mod:`reports.findings`        what the scores show, ranked: biases, coverage failures, comparison

@@ -18,8 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from harness.atomic import write_text_atomic
-from reports.render import (HTML_MAX_ROWS, Report, Section, Table, anchors, png_size,
-                            provenance_items, split_label, table_view)
+from reports.render import Report, Section, Table, anchors, png_size
+from reports.render_tables import HTML_MAX_ROWS, table_view
+from reports.render_values import provenance_items, split_label
 
 __all__ = ["write_html", "html_text"]
 
@@ -208,7 +209,7 @@ def html_text(report: Report, *, max_rows: int | None = HTML_MAX_ROWS) -> str:
     ----------
     report : Report
     max_rows : int or None, optional
-        The most rows shown per table (default :data:`reports.render.HTML_MAX_ROWS`);
+        The most rows shown per table (default :data:`reports.render_tables.HTML_MAX_ROWS`);
         longer tables show their first rows and a note. None shows every row.
 
     Returns

@@ -8,7 +8,7 @@ Layout::
                    "figures": [{"name", "caption"}]}]}
 
 ``numbers`` is written whole. Table ``rows`` are the rows the HTML report shows (the first
-:data:`reports.render.HTML_MAX_ROWS` by default) and ``total_rows`` says how many the table
+:data:`reports.render_tables.HTML_MAX_ROWS` by default) and ``total_rows`` says how many the table
 had; ``columns`` include the index level(s) when the HTML shows them. NaN and infinities
 become ``null``; numpy and pandas scalars become plain JSON values. Figures carry no image
 data (the PNGs are in the HTML report).
@@ -19,7 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from harness.atomic import write_json_atomic
-from reports.render import HTML_MAX_ROWS, Report, jsonable, table_view
+from reports.render import Report
+from reports.render_tables import HTML_MAX_ROWS, table_view
+from reports.render_values import jsonable
 
 __all__ = ["report_dict", "write_json"]
 

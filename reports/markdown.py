@@ -1,7 +1,7 @@
 """A short Markdown summary of a report, for CI logs and pull requests.
 
 Title, status (and why), the summary lines, provenance in a line or two, and each section's first table
-(its first :data:`reports.render.MARKDOWN_MAX_ROWS` rows) as a GitHub table. No images: the
+(its first :data:`reports.render_tables.MARKDOWN_MAX_ROWS` rows) as a GitHub table. No images: the
 figures and the other tables are in the HTML report, which the text points to.
 """
 from __future__ import annotations
@@ -10,7 +10,9 @@ import re
 from pathlib import Path
 
 from harness.atomic import write_text_atomic
-from reports.render import MARKDOWN_MAX_ROWS, Report, provenance_items, split_label, table_view
+from reports.render import Report
+from reports.render_tables import MARKDOWN_MAX_ROWS, table_view
+from reports.render_values import provenance_items, split_label
 
 __all__ = ["markdown_text", "write_markdown"]
 
