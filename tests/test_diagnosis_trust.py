@@ -677,6 +677,7 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     scale_read_as_bias([bias, scale], p)
     assert not bias.selected and not scale.selected
     assert bias.details["scale_rival"]["offset_k"] == pytest.approx(0.1)
+    assert bias.details["scale_rival"]["excursion_k"] == pytest.approx(0.30)
     assert bias.details["as_scale"]["k"] == pytest.approx(0.1)  # the reading the validation test uses
 
 
@@ -755,6 +756,20 @@ def test_the_mismatchs_shape_reads_a_vane_scales_excursions_beside_its_offset():
         bias, scale = pair(shape)
         scale_read_as_bias([bias, scale], p)
         assert not scale.selected and not bias.selected and "read_as" not in bias.details
+    # a named bias (0.100 ± 0.003 read as a scale) beside excursions the kinematics (0.072 ±
+    # 0.012, t 6) and the shape (0.087 ± 0.0068) read together as 0.083 ± 0.006: 2.5 standard
+    # errors apart, so neither is named, and the reason gives the reading that was tested
+    p = SimpleNamespace(smooth={"alpha": np.full(100, 0.0968), "V": np.full(100, 420.0)}, dt=0.02)
+    bias = Candidate("sensor_bias", None, "alpha", "bias_alpha", 0.0088, 0.000264, 33.3, 0.0, "rad",
+                     "kinematic consistency (bias always fitted)", True, "significant, practical and precise")
+    scale = Candidate("sensor_scale", None, "alpha", "scale_alpha", 0.072, 0.012, 6.0, 0.01, "1",
+                      "kinematic consistency", False, "below the entry t",
+                      {"shape": {"k": 0.087, "k_std": 0.0068, "axes": ""}})
+    k_exc, se_exc = excursion_scale(scale)
+    scale_read_as_bias([bias, scale], p)
+    assert not bias.selected and not scale.selected
+    assert bias.details["scale_rival"]["excursion_k"] == pytest.approx(k_exc)
+    assert f"k = {k_exc:.3f} ± {se_exc:.3f} with the mismatch's shape" in bias.reason
 
 
 def test_a_scale_named_on_its_offset_is_tested_the_same_way_on_the_validation_maneuver():

@@ -84,10 +84,11 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
     wander). Lifted when the validation's estimate of the parameter lies at least
     :data:`UNREPLICATED_Z` combined standard errors from the identification's and is not
     itself a suspicion of the same sign (|t| >= :data:`AMBIGUOUS_T`); a validation maneuver
-    that cannot measure it (a large standard error) lifts nothing. Not when either record's kinematics are void
-    (:func:`_kinematics_trusted`), nor when the coefficient mismatch itself reads the
-    suspected vane scale (``details['shape']``, :func:`sensor_naming.withhold_vane_scale`). The term is
-    then judged on the validation maneuver as any finding. (An F-16 at 330 ft/s, lateral,
+    that cannot measure it (a large standard error) lifts nothing. Not when either record's
+    kinematics are void (:func:`_kinematics_trusted`), nor when the coefficient mismatch
+    itself reads the suspected vane scale (``details['shape']``,
+    :func:`sensor_naming.withhold_vane_scale`). The term is then judged on the validation
+    maneuver as any finding. (An F-16 at 330 ft/s, lateral,
     C_n,β +0.04: entered at t 11.7 and withheld for an r-gyro scale of 0.088 ± 0.028, kinematic
     t 3.2, which the validation maneuver put at −0.055 ± 0.022.)
     Returns the candidates of ``a`` it selected."""

@@ -83,11 +83,12 @@ def withhold_vane_scale(cands: list[Candidate], kin: KinematicResult, step: Step
     (:data:`VANE_MEANS_AXES`: C_X, C_Z, C_m for α; C_Y, C_l, C_n for β), as for its bias: on a
     pitch multisine at 420 ft/s with a 10 % α scale, C_l followed the α-scale signature 22 ±
     1.2 times (its α dependence runs through β, which hardly moved) and vetoed the agreement of
-    C_X, C_Z and C_m on k = 0.087. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`) imitates nothing. The
-    common k (its error scaled by the axes' scatter, :func:`birge_scaled`) is kept on the scale's
-    candidate (``details['shape']``): a reading of the vane's excursions independent of the
-    kinematics, which :func:`sensor_rules.scale_read_as_bias` sets beside the offset. It is
-    read too where the term was withheld already because the kinematics suspect that scale
+    C_X, C_Z and C_m on k = 0.087. A scale no vane plausibly has (:data:`kinematics.PLAUSIBLE`)
+    imitates nothing. The common k (its error scaled by the axes' scatter,
+    :func:`birge_scaled`) is kept on the scale's candidate (``details['shape']``): a reading
+    of the vane's excursions independent of the kinematics, which
+    :func:`sensor_rules.scale_read_as_bias` sets beside the offset. It is read too where the
+    term was withheld already because the kinematics suspect that scale
     (``details['sensor_rival']``, :func:`term_rules.withhold_ambiguous`)."""
     for x in ("alpha",) + (() if inertial else ("beta",)):
         name = f"scale_{x}"

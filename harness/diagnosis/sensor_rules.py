@@ -104,7 +104,7 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
         k_exc, se_exc = excursion_scale(scale)
         if np.sign(k_off) != np.sign(k_exc) or abs(k_off - k_exc) > 2.0 * np.hypot(se_off, se_exc):
             if bias.selected:
-                _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, V_mean)
+                _withhold_bias_beside_a_scale(bias, scale, k_off, se_off, k_exc, se_exc, V_mean)
             continue
         k, se = inverse_variance_mean([k_off, k_exc], [se_off, se_exc])
         if not (is_plausible(scale.parameter, k, V_mean) and is_practical(scale.parameter, k, p.dt)):
@@ -137,7 +137,7 @@ def excursion_scale(scale: Candidate) -> tuple[float, float]:
 
 
 def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: float, se_off: float,
-                                  V_mean: float) -> None:
+                                  k_exc: float, se_exc: float, V_mean: float) -> None:
     """Withhold a bias of α or V beside a scale of the same instrument that its excursions
     show (kinematic |t| >= :data:`APPLY_T`, not named) with the sign the offset, read as a
     scale (k = b/x̄_true, plausible), has, when the two do not agree on one scale factor
@@ -145,16 +145,18 @@ def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: floa
     cannot say whether the offset is a bias, the scale's, or both. (An F-16 at 420 ft/s with
     a 10 % α-vane scale, on a pitch multisine: its coefficient means gave an offset of
     0.50° = 0.105 ± 0.003 of the mean α, its excursions k = 0.072 ± 0.012 (t 5.9); it was
-    named a 0.50° α bias.)"""
+    named a 0.50° α bias.) The reason and ``details['scale_rival']`` give the excursions'
+    reading the agreement was tested on (``k_exc ± se_exc``, :func:`excursion_scale`)."""
     if scale.selected or abs(scale.t) < APPLY_T or np.sign(scale.estimate) != np.sign(k_off) \
             or not is_plausible(scale.parameter, k_off, V_mean):
         return
     bias.selected = False
     bias.details["scale_rival"] = {"parameter": scale.parameter, "offset_k": k_off, "offset_k_std": se_off,
-                                   "excursion_k": scale.estimate, "excursion_k_std": scale.std_error}
+                                   "excursion_k": k_exc, "excursion_k_std": se_exc}
+    shape = "" if "shape" not in scale.details else " with the mismatch's shape"
     bias.reason = (f"entered, but not named: {scale.parameter} would make an offset too, and the excursions show one "
-                   f"(k = {scale.estimate:.3f} ± {scale.std_error:.3f}, t = {scale.t:.1f}) that does not agree with "
-                   f"the offset read as a scale (k = {k_off:.3f} ± {se_off:.3f}): bias, scale or both")
+                   f"(the kinematics t = {scale.t:.1f}; k = {k_exc:.3f} ± {se_exc:.3f}{shape}) that does not agree "
+                   f"with the offset read as a scale (k = {k_off:.3f} ± {se_off:.3f}): bias, scale or both")
 
 
 def withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResult, p: Prepared,
