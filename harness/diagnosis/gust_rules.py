@@ -118,6 +118,14 @@ def withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:
             c.reason = f"not named: {why}"
 
 
+def mode_candidate(peak, selected: bool, reason: str) -> Candidate:
+    """The structural-mode candidate of spectral peak ``peak`` (:class:`spectra.PeakTest`):
+    its frequency, with −log10 p as its t."""
+    return Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
+                     peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), peak.g, "Hz",
+                     "residual-spectrum peak over its local median", selected, reason, {"amplitude": peak.amplitude})
+
+
 def spectral_candidates(peak, gust, turbulent: bool, light: bool = False,
                         air: AirShare | None = None) -> list[Candidate]:
     """The structural-mode peak (named at p < :data:`FISHER_P`) and the gust level (named in
@@ -126,11 +134,7 @@ def spectral_candidates(peak, gust, turbulent: bool, light: bool = False,
     out = []
     if peak is not None:
         sel = peak.p_value < FISHER_P
-        out.append(Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
-                             peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), peak.g, "Hz",
-                             "residual-spectrum peak over its local median", sel,
-                             f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else ""),
-                             {"amplitude": peak.amplitude}))
+        out.append(mode_candidate(peak, sel, f"peak p = {peak.p_value:.2g}" + (" (significant)" if sel else "")))
     sigma = max(gust.sigma_w_fps, gust.sigma_v_fps)
     details = {"sigma_w_fps": gust.sigma_w_fps, "sigma_v_fps": gust.sigma_v_fps}
     reason = f"gust/noise ratio {gust.ratio_to_noise:.1f}"

@@ -15,7 +15,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
                                          write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import instruments_at_cg, prepare
-from harness.diagnosis.replication import lift_unreplicated_suspicions, name_replicated
+from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
 from harness.diagnosis.validation import undecided, validation_check
 from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, chosen_findings,
                                        excited_axes, finding_dict, focus_axis, located_paragraph, none_finding,
@@ -146,6 +146,7 @@ def _checked(a: Analysis, av: Analysis | None) -> tuple[list[Candidate], list[Ca
     if av is not None:  # sensor biases each maneuver only suspects, named on the two; and
         name_replicated(a, av)  # terms withheld for a sensor suspicion the validation does not share
         lift_unreplicated_suspicions(a, av)
+        name_mode_on_both(a, av)  # and a mode the validation maneuver rings louder
     findings = chosen_findings(a)
     checks = {id(f): validation_check(av, f) if av is not None else undecided(f) for f in findings}
     unconfirmed = [f for f in findings if (checks[id(f)] or {"status": "confirmed"})["status"]

@@ -12,6 +12,7 @@ from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import MEANS_TESTS
 from harness.diagnosis.sensor_rules import excursion_scale
+from harness.diagnosis.spectra import MODE_CONFIRM_P, peak_at, untestable_at
 
 
 def after_mismatch(a: Analysis, findings: list[Candidate]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
@@ -56,6 +57,8 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     noise level, drops by 1 % or more), 'contradicted' (it rises by 1 % or more) or 'neutral';
     None for a finding with no coefficient term (a sensor effect, a gust level, a spectral
     peak)."""
+    if f.effect == "structural_mode":
+        return _mode_check(av, f)
     if f.test in MEANS_TESTS.values():
         return _vane_means_check(av, f)
     if f.test.startswith("kinematic consistency") or f.parameter == "x_accelerometer":
@@ -83,6 +86,26 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
         elif rival["indistinct"]:
             out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
     return out
+
+
+def _mode_check(av: Analysis, f: Candidate) -> dict:
+    """A structural mode on the validation maneuver: 'confirmed' when its spectrum shows the
+    mode too, on the same channel within a bin of the frequency found (p <
+    :data:`spectra.MODE_CONFIRM_P`, :func:`spectra.peak_at`), or when the mode was named on
+    the two together (:func:`replication.name_mode_on_both`); else 'untested': a maneuver that
+    does not ring the mode (a lateral one, for a mode the stabilator drives) cannot refute it,
+    and one whose record cannot show it (:func:`spectra.untestable_at`) says why."""
+    both = f.details.get("replicated")
+    p_v = both["validation_p"] if both else peak_at(av.prepared, f.channel, f.estimate)
+    why = "" if both else untestable_at(av.prepared, f.channel, f.estimate)
+    if why:
+        return {"status": "untested", "axes": [], "reason": f"the validation maneuver cannot show the mode: {why}"}
+    if p_v < MODE_CONFIRM_P:
+        return {"status": "confirmed", "axes": [], "p_value": p_v,
+                "reason": f"the validation maneuver's {f.channel} spectrum shows it too (p = {p_v:.2g})"}
+    return {"status": "untested", "axes": [], "p_value": p_v,
+            "reason": f"the validation maneuver's {f.channel} spectrum does not show it above its noise "
+                      f"(p = {p_v:.2g}; a maneuver that does not ring the mode cannot test it)"}
 
 
 def untestable(pv: Prepared, f: Candidate) -> str:

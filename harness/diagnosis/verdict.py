@@ -207,6 +207,10 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
         text = template.format(**fmt)
     except (KeyError, ValueError):
         text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
+    both = c.details.get("replicated")
+    if both:  # replication.name_mode_on_both: named on the two maneuvers
+        text += (f" The identification maneuver rings it too weakly to name alone (p = {both['identification_p']:.2g} "
+                 f"at that frequency); the validation maneuver's peak (p = {both['validation_p']:.2g}) names it.")
     if c.details.get("not_ruled_out"):  # an assumption the result rests on (term_rules._withhold_skewed_delay)
         text += f" Caveat: {c.details['not_ruled_out']}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}

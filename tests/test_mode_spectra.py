@@ -1,0 +1,127 @@
+"""The structural-mode peak test against inputs' spectral lines and across two maneuvers
+(harness.diagnosis.spectra, replication.name_mode_on_both, validation._mode_check)."""
+from types import SimpleNamespace
+
+import numpy as np
+from scipy import signal, stats
+
+from harness.diagnosis import spectra
+from harness.diagnosis.evidence import Candidate
+
+FS, N = 50.0, 1500
+
+
+def _record(**raw):
+    """A stand-in for a prepared recording: ``raw`` channels, nothing smoothed out."""
+    return SimpleNamespace(dt=1.0 / FS, n=N, raw=raw, smooth={c: np.zeros(N) for c in raw}, common_cutoff_hz=0.7)
+
+
+def _roll_echo(seed: int):
+    """An aileron with a 5 Hz line (an input harmonic) and the roll rate of a fast roll mode
+    (time constant 0.1 s) that follows it, each with its own white noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(N) / FS
+    da = 0.004 * np.sin(2 * np.pi * 5.0 * t) + 0.002 * rng.normal(size=N)
+    roll = signal.lti([1.0], [0.1, 1.0])
+    _, p, _ = signal.lsim(roll, da, t)
+    return da, p + 0.0006 * rng.normal(size=N)
+
+
+def test_a_roll_rate_following_the_ailerons_line_is_no_mode():
+    """The roll rate's 5 Hz line beats white noise by far (a 'mode' when the aileron is not
+    recorded), but it is the aileron line's echo: it stands no further above its median than
+    the line does."""
+    da, p = _roll_echo(1)
+    alone = spectra.structural_peak(_record(p=p))
+    assert alone.p_value < spectra.FISHER_P and abs(alone.frequency_hz - 5.0) < 0.3
+    with_input = spectra.structural_peak(_record(p=p, da=da))
+    assert with_input is None or with_input.p_value > 1e-3
+    assert spectra.peak_at(_record(p=p, da=da), "p", 5.0) == 1.0
+
+
+def test_a_mode_ringing_far_above_a_weak_stabilator_line_is_still_a_mode():
+    """An 8 Hz mode in q where the stabilator carries a weak line of its own (an input
+    harmonic) stands far further above its median than the line: a mode. The aileron's line
+    at the same frequency drives no pitch channel."""
+    rng = np.random.default_rng(2)
+    t = np.arange(N) / FS
+    de = 0.0015 * np.sin(2 * np.pi * 8.0 * t) + 0.002 * rng.normal(size=N)
+    da = 0.01 * np.sin(2 * np.pi * 8.0 * t) + 0.002 * rng.normal(size=N)
+    q = 0.003 * np.sin(2 * np.pi * 8.0 * t) + 0.002 * rng.normal(size=N)
+    peak = spectra.structural_peak(_record(q=q, de=de, da=da))
+    assert peak.p_value < spectra.FISHER_P and abs(peak.frequency_hz - 8.0) < 0.25
+    lines = spectra.input_lines(_record(q=q, de=de, da=da), 100, spectra.welch_dof(N, 100), 2.5)
+    assert lines["de"][16] > 1.0 and lines["da"][16] > lines["de"][16]  # 8 Hz, 0.5 Hz bins
+
+
+def test_echo_is_the_f_test_of_the_two_ratios():
+    """spectra.echoes: a peak on a driving surface's line is an echo unless the ratio of the
+    two ratios beats F(dof, dof) at ECHO_P; no line, or a surface that does not drive the
+    channel, is no echo."""
+    dof = 55.0
+    limit = stats.f.isf(spectra.ECHO_P, dof, dof)
+    line = np.zeros(10)
+    line[4] = 2.0
+    idx = np.array([4, 4, 7])
+    ratio = np.array([2.0 * limit * 0.99, 2.0 * limit * 1.01, 9.0])
+    assert spectra.echoes(ratio, idx, "q", {"de": line}, dof).tolist() == [True, False, False]
+    assert not spectra.echoes(ratio, idx, "q", {"da": line}, dof).any()
+
+
+def test_peak_at_a_given_frequency():
+    """spectra.peak_at: three ordinates at a frequency given in advance, Bonferroni over the
+    three; NaN where the record cannot tell (spectra.untestable_at: an unrecorded channel, a
+    frequency outside the searched band)."""
+    rng = np.random.default_rng(4)
+    t = np.arange(N) / FS
+    q = 0.0012 * np.sin(2 * np.pi * 8.0 * t) + 0.002 * rng.normal(size=N)
+    rec = _record(q=q)
+    assert spectra.peak_at(rec, "q", 8.0) < spectra.MODE_CONFIRM_P
+    assert spectra.peak_at(rec, "q", 13.0) > spectra.MODE_CONFIRM_P
+    assert np.isnan(spectra.peak_at(rec, "az", 8.0)) and np.isnan(spectra.peak_at(rec, "q", 30.0))
+    assert "does not record az" in spectra.untestable_at(rec, "az", 8.0)
+    assert "band is 2.1-22.5 Hz" in spectra.untestable_at(rec, "q", 1.5)
+    slow = _record(q=rec.raw["q"])
+    slow.common_cutoff_hz = 4.0  # its smoothing keeps 8 Hz as motion
+    assert np.isnan(spectra.peak_at(slow, "q", 8.0)) and "cut-off of 4.0 Hz" in spectra.untestable_at(slow, "q", 8.0)
+
+
+def _analysis(rec, peak, candidates=()):
+    return SimpleNamespace(prepared=rec, peak=peak, candidates=list(candidates))
+
+
+def test_a_mode_the_validation_rings_is_named_when_the_identification_shows_it_there():
+    """replication.name_mode_on_both: the validation's peak (p < FISHER_P) named when the
+    identification's spectrum shows an excess there (p < MODE_CONFIRM_P) though not enough
+    to name alone; not when it shows nothing there, nor when it names a mode itself. The
+    validation check of the finding is then 'confirmed'."""
+    from harness.diagnosis.replication import name_mode_on_both
+    from harness.diagnosis.validation import validation_check
+    rng = np.random.default_rng(6)
+    t = np.arange(N) / FS
+    loud = _record(q=0.006 * np.sin(2 * np.pi * 8.0 * t) + 0.002 * rng.normal(size=N))
+    weak = _record(q=0.0005 * np.sin(2 * np.pi * 8.0 * t) + 0.002 * rng.normal(size=N))
+    quiet = _record(q=0.002 * rng.normal(size=N))
+    pv = spectra.structural_peak(loud)
+    assert pv.p_value < spectra.FISHER_P
+    assert spectra.structural_peak(weak).p_value > spectra.FISHER_P
+    a = _analysis(weak, spectra.structural_peak(weak))
+    named = name_mode_on_both(a, _analysis(loud, pv))
+    assert named is not None and named.selected and named.estimate == pv.frequency_hz
+    assert [c.parameter for c in a.candidates] == ["mode_frequency_hz"]
+    check = validation_check(_analysis(loud, pv), named)
+    assert check["status"] == "confirmed"
+    from harness.diagnosis.verdict import finding_dict
+    text = finding_dict(named, {}, {}, check)["explanation"]
+    assert "too weakly to name alone" in text and "validation maneuver's peak" in text
+    assert name_mode_on_both(_analysis(quiet, None), _analysis(loud, pv)) is None
+    own = Candidate("structural_mode", None, "q", "mode_frequency_hz", 12.0, 0.25, 9.0, 3.0, "Hz", "", True)
+    assert name_mode_on_both(_analysis(weak, None, [own]), _analysis(loud, pv)) is None
+    # a mode named on the identification alone that the validation maneuver does not ring
+    check = validation_check(_analysis(quiet, None), own)
+    assert check["status"] == "untested" and "does not show it" in check["reason"]
+    lateral = _record(p=quiet.raw["q"])
+    check = validation_check(_analysis(lateral, None), own)
+    assert check["status"] == "untested" and "cannot show the mode: it does not record q" in check["reason"]
+    # an identification that cannot tell (NaN) names nothing
+    assert name_mode_on_both(_analysis(_record(p=quiet.raw["q"]), None), _analysis(loud, pv)) is None
