@@ -123,5 +123,38 @@ def test_a_mode_the_validation_rings_is_named_when_the_identification_shows_it_t
     lateral = _record(p=quiet.raw["q"])
     check = validation_check(_analysis(lateral, None), own)
     assert check["status"] == "untested" and "cannot show the mode: it does not record q" in check["reason"]
-    # an identification that cannot tell (NaN) names nothing
-    assert name_mode_on_both(_analysis(_record(p=quiet.raw["q"]), None), _analysis(loud, pv)) is None
+    # an identification that cannot tell (it does not record q): named on the validation alone
+    alone = name_mode_on_both(_analysis(_record(p=quiet.raw["q"]), None), _analysis(loud, pv))
+    assert alone.details["replicated"]["identification_cannot"] == "it does not record q"
+
+
+def test_a_mode_the_identification_could_not_ring_is_named_on_the_validation_alone():
+    """replication.name_mode_on_both with spectra.predicted_peak_p: the validation's
+    stabilator carries power at 8 Hz (band-limited noise below 12 Hz, above its white floor)
+    and rings the mode; an identification whose stabilator carries nothing there but its
+    floor could not have shown it, and the mode is named on the validation alone, saying
+    so. An identification whose stabilator drives 8 Hz as hard and shows nothing there
+    contradicts it: not named."""
+    from harness.diagnosis.replication import name_mode_on_both
+    rng = np.random.default_rng(8)
+    b, a = signal.butter(4, 12.0 / (FS / 2))
+    mode = signal.lti([(2 * np.pi * 8.0) ** 2], [1.0, 2 * 0.02 * 2 * np.pi * 8.0, (2 * np.pi * 8.0) ** 2])
+    t = np.arange(N) / FS
+
+    def record(drive: float, rings: bool):
+        de = drive * signal.filtfilt(b, a, rng.normal(size=N))
+        _, x, _ = signal.lsim(mode, de, t)
+        q = (0.15 * (x - de) if rings else 0.0) + 0.0005 * rng.normal(size=N)
+        return _record(q=q, de=de + 0.0002 * rng.normal(size=N))
+
+    val = record(0.01, True)
+    pv = spectra.structural_peak(val)
+    assert pv.p_value < spectra.FISHER_P and abs(pv.frequency_hz - 8.0) < 0.5
+    quiet = record(0.0, False)
+    assert spectra.predicted_peak_p(quiet, val, "q", pv.frequency_hz) >= spectra.MODE_CONFIRM_P
+    named = name_mode_on_both(_analysis(quiet, None), _analysis(val, pv))
+    assert named is not None and "validation maneuver alone" in named.reason
+    assert "too little power" in named.details["replicated"]["identification_cannot"]
+    driven = record(0.01, False)
+    assert spectra.predicted_peak_p(driven, val, "q", pv.frequency_hz) < spectra.MODE_CONFIRM_P
+    assert name_mode_on_both(_analysis(driven, None), _analysis(val, pv)) is None

@@ -14,7 +14,7 @@ from harness.diagnosis.gust_rules import mode_candidate
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_estimate, kinematic_rival, kinematic_std_error,
                                             kinematics_plausible, sensor_verdict)
-from harness.diagnosis.spectra import FISHER_P, MODE_CONFIRM_P, peak_at
+from harness.diagnosis.spectra import FISHER_P, MODE_CONFIRM_P, peak_at, predicted_peak_p, untestable_at
 from models.hidden import SENSOR_EFFECTS
 
 
@@ -135,24 +135,39 @@ def _kinematics_trusted(a: Analysis) -> bool:
 
 def name_mode_on_both(a: Analysis, av: Analysis) -> Candidate | None:
     """Name the structural mode the validation maneuver's spectrum shows (p < :data:`FISHER_P`,
-    not on a surface's line) when the identification's shows it too, on the same channel
-    within a bin of the same frequency (p < :data:`MODE_CONFIRM_P`, :func:`spectra.peak_at`),
-    and names no mode of its own: the airframe flew both, and a maneuver whose stabilator
-    hardly moves at the mode's frequency rings it too weakly to name alone (an 8 Hz mode on a
-    three-axis maneuver at 15,000 ft / 550 ft/s: p = 1e-4 on the identification, 5e-53 on
-    the validation; outside sweep, 4 Dec 2026). The frequency is the validation's. Returns
-    the candidate it named (replacing the identification's own), or None."""
+    not the echo of a surface's line) when the identification names no mode of its own and
+    either shows it too, on the same channel within a bin of the same frequency (p <
+    :data:`MODE_CONFIRM_P`, :func:`spectra.peak_at`), or could not have shown it: its record
+    cannot tell at that frequency (:func:`spectra.untestable_at`), or its input carries too
+    little power there to ring the mode above its noise (:func:`spectra.predicted_peak_p`,
+    p ≥ :data:`MODE_CONFIRM_P`). The airframe flew both, and a maneuver whose stabilator
+    hardly moves at the mode's frequency rings it too weakly to name alone: an 8 Hz mode on a
+    three-axis maneuver at 15,000 ft / 550 ft/s, p = 1e-4 on the identification, 5e-53 on
+    the validation (outside sweep, 4 Dec 2026); a multisine up to 2 Hz does not ring a 6 Hz
+    mode at all, a 3-2-1-1 validation does at p = 1e-29 (probe 12). An identification that
+    could have shown it and does not contradicts it: not named. The frequency is the
+    validation's. Returns the candidate it named (replacing the identification's own), or
+    None."""
     peak = av.peak
     if peak is None or peak.p_value >= FISHER_P:
         return None
     if any(c.selected and c.effect == "structural_mode" for c in a.candidates):
         return None
     p_id = peak_at(a.prepared, peak.channel, peak.frequency_hz)
-    if not p_id < MODE_CONFIRM_P:  # NaN: the identification cannot tell
-        return None
-    c = mode_candidate(peak, True, f"named on the two maneuvers: the validation's peak at {peak.frequency_hz:.2f} Hz "
-                                   f"in {peak.channel} (p = {peak.p_value:.2g}) and the identification's excess "
-                                   f"there (p = {p_id:.2g})")
-    c.details["replicated"] = {"validation_p": peak.p_value, "identification_p": p_id}
+    where = f"the validation's peak at {peak.frequency_hz:.2f} Hz in {peak.channel} (p = {peak.p_value:.2g})"
+    why = ""
+    if p_id < MODE_CONFIRM_P:
+        reason = f"named on the two maneuvers: {where} and the identification's excess there (p = {p_id:.2g})"
+    else:
+        why = untestable_at(a.prepared, peak.channel, peak.frequency_hz)
+        if not why:
+            predicted = predicted_peak_p(a.prepared, av.prepared, peak.channel, peak.frequency_hz)
+            if not predicted >= MODE_CONFIRM_P:  # it could have shown it (or no surface says it could not)
+                return None
+            why = (f"its input carries too little power at {peak.frequency_hz:.2f} Hz to ring the mode above its "
+                   f"noise (expected p = {predicted:.2g})")
+        reason = f"named on the validation maneuver alone: {where}; the identification cannot show it: {why}"
+    c = mode_candidate(peak, True, reason)
+    c.details["replicated"] = {"validation_p": peak.p_value, "identification_p": p_id, "identification_cannot": why}
     a.candidates[:] = [x for x in a.candidates if x.effect != "structural_mode"] + [c]
     return c

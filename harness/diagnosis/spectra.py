@@ -125,6 +125,41 @@ def peak_at(p: Prepared, channel: str, frequency_hz: float, segment_s: float = 2
     return peak_p_value(float(ratios[j]), near.size, dof)
 
 
+def predicted_peak_p(p: Prepared, pv: Prepared, channel: str, frequency_hz: float, segment_s: float = 2.0,
+                     half_width_hz: float = 2.5) -> float:
+    """How clearly record ``p`` should show the mode record ``pv`` shows on ``channel`` at
+    ``frequency_hz``, had it rung it: ``pv``'s excess over its running median there, scaled
+    by how much less power the surfaces driving the channel (:data:`DRIVEN_BY`) carry at that
+    frequency in ``p`` than in ``pv`` (the largest ratio over them, within a bin, of the power
+    above each surface's white sensor floor, the median of its top band, 0.7-0.9 of Nyquist: a
+    mode rings in proportion to its input's power at its frequency), over ``p``'s own median;
+    :func:`peak_p_value` of that ratio, Bonferroni over three ordinates. A record whose
+    driving surfaces carry nothing above their floor there cannot ring the mode. NaN where either record cannot tell
+    (:func:`untestable_at`) or no driving surface is recorded in both."""
+    if untestable_at(p, channel, frequency_hz, segment_s) or untestable_at(pv, channel, frequency_hz, segment_s):
+        return float("nan")
+    surfaces = [s for s in DRIVEN_BY.get(channel, ()) if s in p.raw and s in pv.raw]
+    if not surfaces:
+        return float("nan")
+
+    def spectrum(r: Prepared, c: str):
+        f, P, med, _ = _median_spectrum(r.raw[c] - r.smooth[c], 1.0 / r.dt, int(round(segment_s / r.dt)), half_width_hz)
+        k = int(np.argmin(np.abs(f - frequency_hz)))
+        near = slice(max(k - 1, 0), min(k + 2, f.size))
+        return P[near], med[near], float(np.median(P[(f >= 0.7 * f[-1]) & (f <= 0.9 * f[-1])]))
+
+    def drive(r: Prepared, s: str) -> float:  # the surface's power there above its sensor's white floor
+        P, _, floor = spectrum(r, s)
+        return max(float(np.max(P)) - floor, 0.0)
+
+    scale = max(drive(p, s) / max(drive(pv, s), 1e-300) for s in surfaces)
+    P_v, med_v, _ = spectrum(pv, channel)
+    med_i = spectrum(p, channel)[1]
+    excess = float(np.max(P_v - med_v))
+    ratio = 1.0 + min(scale, 1.0) * max(excess, 0.0) / max(float(np.median(med_i)), 1e-300)
+    return peak_p_value(ratio, 3, welch_dof(p.n, int(round(segment_s / p.dt))))
+
+
 def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: float = 2.0,
                   f_min_hz: float = 2.0) -> str:
     """Why record ``p`` cannot show a mode of ``channel`` at ``frequency_hz`` ('' when it can):

@@ -208,7 +208,10 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     except (KeyError, ValueError):
         text = f"{c.effect}: {c.parameter} = {c.estimate:.4g} ± {c.std_error:.2g} {c.units}."
     both = c.details.get("replicated")
-    if both:  # replication.name_mode_on_both: named on the two maneuvers
+    if both and both.get("identification_cannot"):  # replication.name_mode_on_both: the validation's alone
+        text += (f" The identification maneuver cannot show it ({both['identification_cannot']}); the validation "
+                 f"maneuver's peak (p = {both['validation_p']:.2g}) names it: it rests on the validation maneuver alone.")
+    elif both:  # named on the two maneuvers
         text += (f" The identification maneuver rings it too weakly to name alone (p = {both['identification_p']:.2g} "
                  f"at that frequency); the validation maneuver's peak (p = {both['validation_p']:.2g}) names it.")
     if c.details.get("not_ruled_out"):  # an assumption the result rests on (term_rules._withhold_skewed_delay)
