@@ -155,6 +155,12 @@ def test_a_mode_the_identification_could_not_ring_is_named_on_the_validation_alo
     named = name_mode_on_both(_analysis(quiet, None), _analysis(val, pv))
     assert named is not None and "validation maneuver alone" in named.reason
     assert "too little power" in named.details["replicated"]["identification_cannot"]
+    from harness.diagnosis.validation import validation_check
+    from harness.diagnosis.verdict import finding_dict
+    check = validation_check(_analysis(val, pv), named)
+    assert check["status"] == "untested" and "validation maneuver's own spectrum" in check["reason"]
+    text = finding_dict(named, {}, {}, check)["explanation"]
+    assert "rests on the validation maneuver alone" in text and "identification maneuver alone" not in text
     driven = record(0.01, False)
     assert spectra.predicted_peak_p(driven, val, "q", pv.frequency_hz) < spectra.MODE_CONFIRM_P
     assert name_mode_on_both(_analysis(driven, None), _analysis(val, pv)) is None

@@ -134,8 +134,9 @@ def predicted_peak_p(p: Prepared, pv: Prepared, channel: str, frequency_hz: floa
     above each surface's white sensor floor, the median of its top band, 0.7-0.9 of Nyquist: a
     mode rings in proportion to its input's power at its frequency), over ``p``'s own median;
     :func:`peak_p_value` of that ratio, Bonferroni over three ordinates. A record whose
-    driving surfaces carry nothing above their floor there cannot ring the mode. NaN where either record cannot tell
-    (:func:`untestable_at`) or no driving surface is recorded in both."""
+    driving surfaces carry nothing above their floor there cannot ring the mode. NaN where
+    either record cannot tell (:func:`untestable_at`) or no driving surface is recorded in
+    both."""
     if untestable_at(p, channel, frequency_hz, segment_s) or untestable_at(pv, channel, frequency_hz, segment_s):
         return float("nan")
     surfaces = [s for s in DRIVEN_BY.get(channel, ()) if s in p.raw and s in pv.raw]
@@ -143,7 +144,8 @@ def predicted_peak_p(p: Prepared, pv: Prepared, channel: str, frequency_hz: floa
         return float("nan")
 
     def spectrum(r: Prepared, c: str):
-        f, P, med, _ = _median_spectrum(r.raw[c] - r.smooth[c], 1.0 / r.dt, int(round(segment_s / r.dt)), half_width_hz)
+        nper = int(round(segment_s / r.dt))
+        f, P, med, _ = _median_spectrum(r.raw[c] - r.smooth[c], 1.0 / r.dt, nper, half_width_hz)
         k = int(np.argmin(np.abs(f - frequency_hz)))
         near = slice(max(k - 1, 0), min(k + 2, f.size))
         return P[near], med[near], float(np.median(P[(f >= 0.7 * f[-1]) & (f <= 0.9 * f[-1])]))
@@ -174,8 +176,8 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
         return f"it is shorter than {4 * segment_s:g} s"
     low = max(f_min_hz, 3.0 * p.common_cutoff_hz)
     if not low <= frequency_hz <= 0.9 * 0.5 * fs:
-        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (three times its common filter's cut-off of "
-                f"{p.common_cutoff_hz:.1f} Hz up to 0.9 of Nyquist)")
+        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or three times its common "
+                f"filter's cut-off of {p.common_cutoff_hz:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
     return ""
 
 

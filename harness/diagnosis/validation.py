@@ -92,10 +92,14 @@ def _mode_check(av: Analysis, f: Candidate) -> dict:
     """A structural mode on the validation maneuver: 'confirmed' when its spectrum shows the
     mode too, on the same channel within a bin of the frequency found (p <
     :data:`spectra.MODE_CONFIRM_P`, :func:`spectra.peak_at`), or when the mode was named on
-    the two together (:func:`replication.name_mode_on_both`); else 'untested': a maneuver that
+    the two together (:func:`replication.name_mode_on_both`); 'untested' when it was named on
+    the validation maneuver alone (nothing independent tests it), or a maneuver that
     does not ring the mode (a lateral one, for a mode the stabilator drives) cannot refute it,
     and one whose record cannot show it (:func:`spectra.untestable_at`) says why."""
     both = f.details.get("replicated")
+    if both and both.get("identification_cannot"):  # named from this maneuver's own spectrum
+        return {"status": "untested", "axes": [], "p_value": both["validation_p"],
+                "reason": "it was named on the validation maneuver's own spectrum; the identification cannot show it"}
     p_v = both["validation_p"] if both else peak_at(av.prepared, f.channel, f.estimate)
     why = "" if both else untestable_at(av.prepared, f.channel, f.estimate)
     if why:

@@ -210,7 +210,8 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     both = c.details.get("replicated")
     if both and both.get("identification_cannot"):  # replication.name_mode_on_both: the validation's alone
         text += (f" The identification maneuver cannot show it ({both['identification_cannot']}); the validation "
-                 f"maneuver's peak (p = {both['validation_p']:.2g}) names it: it rests on the validation maneuver alone.")
+                 f"maneuver's peak (p = {both['validation_p']:.2g}) names it: it rests on the validation maneuver "
+                 "alone.")
     elif both:  # named on the two maneuvers
         text += (f" The identification maneuver rings it too weakly to name alone (p = {both['identification_p']:.2g} "
                  f"at that frequency); the validation maneuver's peak (p = {both['validation_p']:.2g}) names it.")
@@ -220,7 +221,8 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
     if check is not None:
         evidence["validation"] = check
-        if check["status"] == "untested":  # an assumption the result rests on: the identification alone
+        if check["status"] == "untested" and not (both and both.get("identification_cannot")):
+            # an assumption the result rests on: the identification alone
             why = check["reason"]
             text += f" {why[:1].upper()}{why[1:]}: it rests on the identification maneuver alone."
         if check["status"] == "contradicted" and "change" in check:
