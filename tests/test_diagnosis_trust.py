@@ -1038,3 +1038,71 @@ def test_a_recorders_anti_alias_filter_is_the_noise_floors_shape():
     fits, filtered = _own_smoothing(unfiltered, 1 / fs)
     assert filtered == []
     assert fits["alpha"].noise_variance == optimal_fourier_smoother(unfiltered["alpha"], 1 / fs).noise_variance
+
+
+def test_a_moment_reference_shift_is_no_rival_when_cm_lacks_its_mistrim():
+    """term_rules._refuted_shift: on a lateral maneuver the C_Y column a moment-reference shift
+    puts in C_n follows β as C_n,β's does, so the shift rivals a C_n,β change. The shift the
+    rival needs (its coefficient fitted in the term's place, times −b) also mistrims C_m by
+    Δx·mean(C_Z)/c̄; when C_m's constant lacks it (stepwise_axes.shift_mistrim_test) the shift
+    is refuted, not a rival. With the mistrim there, or for a rival of another effect, it stands."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.rivals import Rival
+    from harness.diagnosis.term_rules import _refuted_shift
+    rng = np.random.default_rng(5)
+    n, cbar, b, dx = 1500, 11.32, 30.0, 1.3
+    CZ = -0.4 + 0.005 * np.sin(np.linspace(0.0, 20.0, n))
+    CY = 0.02 * np.sin(np.linspace(0.0, 13.0, n))
+    p = SimpleNamespace(dt=0.02, n=n, meta={"geometry": {"cbar_ft": cbar, "b_ft": b}})
+    by_key = {"cg": SimpleNamespace(effect="cg_offset", scale=-b, column=CY),
+              "beta": SimpleNamespace(effect="coefficient_error", scale=1.0, column=CY)}
+    selections = {"Cm": (SimpleNamespace(names=(), params={}), {}), "Cn": (SimpleNamespace(names=("beta",)), by_key)}
+    measured = {"CZ": CZ, "CY": CY, "Cm": 0.01 * np.sin(np.linspace(0.0, 9.0, n))}
+    noise = 1e-4 * rng.standard_normal(n)
+    rival = Rival("cg", -0.96, 2.9, -1.9, dx / -b)
+    predicted = dx * float(np.mean(CZ)) / cbar                       # about −0.046
+    untrimmed = {"Cm": noise, "Cn": -dx / b * CY + noise}
+    why = _refuted_shift(rival, by_key, "Cn", p, selections, {}, untrimmed, measured)
+    assert why.startswith("refuted by the mean of C_m") and "1.3 ft" in why
+    mistrimmed = {"Cm": predicted + noise, "Cn": untrimmed["Cn"]}
+    assert _refuted_shift(rival, by_key, "Cn", p, selections, {}, mistrimmed, measured) == ""
+    other = Rival("beta", -0.96, 2.9, -1.9, 0.05)
+    assert _refuted_shift(other, by_key, "Cn", p, selections, {}, untrimmed, measured) == ""
+    assert _refuted_shift(None, by_key, "Cn", p, selections, {}, untrimmed, measured) == ""
+
+
+def test_a_term_whose_shift_rival_was_refuted_must_enter_on_the_validation_too():
+    """validation.unreplicated: a term the identification could not tell from a moment-reference
+    shift (t beside it under the entry t), the shift then refuted by the mean of C_m, stands on
+    its own t alone; it is named only when the validation maneuver's own fit enters the same
+    parameter with the same sign (|t| >= candidates.T_IN). A term that set its rival apart, or
+    had none refuted, is not asked."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.candidates import T_IN
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.validation import unreplicated
+    refuted = {"parameter": "dx_moment_reference", "effect": "cg_offset", "correlation": -0.95, "t_term": -1.0,
+               "reason": "refuted by the mean of C_m"}
+    f = Candidate("coefficient_error", "yaw", "Cn", "Cn_beta", 0.2034, 0.002, -6.3, 0.27, "per rad",
+                  "stepwise on the Cn mismatch", True, details={"change": -0.0127, "refuted_rival": refuted})
+
+    def validation(t):
+        twin = Candidate("coefficient_error", "yaw", "Cn", "Cn_beta", 0.2024, 0.0019, t, 0.1, "per rad",
+                         "stepwise on the Cn mismatch", abs(t) >= T_IN)
+        return SimpleNamespace(candidates=[twin])
+
+    why = unreplicated(validation(-4.0), f)
+    assert "t = -4.0" in why and "refutes" in why
+    assert unreplicated(validation(-T_IN - 0.1), f) == ""
+    assert unreplicated(validation(T_IN + 3.0), f) != ""                   # the other sign
+    assert unreplicated(SimpleNamespace(candidates=[]), f) != ""          # not offered there
+    apart = Candidate(f.effect, f.axis, f.channel, f.parameter, f.estimate, f.std_error, f.t, 0.27, f.units, f.test,
+                      True, details={"refuted_rival": refuted | {"t_term": -T_IN - 1.0}})
+    assert unreplicated(validation(0.0), apart) == ""
+    plain = Candidate(f.effect, f.axis, f.channel, f.parameter, f.estimate, f.std_error, f.t, 0.27, f.units, f.test,
+                      True)
+    assert unreplicated(validation(0.0), plain) == ""

@@ -437,3 +437,24 @@ def test_an_alpha_scale_at_the_flap_switch_is_named_alone(tmp_path):
     f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
     bias = next(x for x in f["candidates"] if x["parameter"] == "bias_alpha")
     assert bias["reason"].startswith("read as the offset of scale_alpha")
+
+
+def test_a_cn_beta_change_on_a_lateral_maneuver_is_not_taken_for_a_moment_reference_shift(tmp_path, monkeypatch):
+    """A C_n,β change of +0.05 on a lateral maneuver at 30,000 ft and 620 ft/s (a condition no
+    sweep flies; larger inputs than the sweeps'). The C_Y column of a moment-reference shift
+    follows β (correlation −0.96), so the shift rivalled C_n,β and the validation maneuver,
+    fitted about as well by either, left the finding ambiguous: `none`. The 1.3 ft shift it
+    needs would mistrim C_m by −0.045, and C_m's mismatch has no such constant
+    (term_rules._refuted_shift): C_n,β is named, its size within 2 standard errors or 25 %,
+    nothing else, the validation's r fit better by 30 % or more."""
+    from harness.diagnosis import outside_cases as oc
+    from harness.diagnosis.outside import run_case
+    monkeypatch.setitem(oc.CONDITIONS, "G3", oc.Condition("G3", "f16", "h=30000,V=620", 2.0, 4.0, 4.0, 0.3))
+    c = oc.OutsideCase("G3_lateral_coefficient_error_Cn_beta_0.05", "G3", "lateral",
+                       (oc.H("coefficient_error", 0.05, coefficient="Cn", regressor="beta"),), "coefficient_error",
+                       "Cn_beta", 0.05, "r", seed=13103, drop=oc._drops(3))
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["d"] and row["c"] == 0, (row["first"], row["false"])
+    f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
+    assert f["evidence"]["refuted_rival"]["parameter"] == "dx_moment_reference"
+    assert f["evidence"]["validation"]["status"] == "confirmed"

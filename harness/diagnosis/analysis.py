@@ -80,7 +80,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_explained_by_lift(cands, step.selections, mismatch, p)
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
-    withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0)
+    withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
+                    measured)
     withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step))
     if turbulent:
         withhold_in_turbulence(cands)

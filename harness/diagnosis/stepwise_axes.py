@@ -224,8 +224,20 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     sel, by_key = selections[axis]
     if "cg" not in sel.names:
         return None
-    term = by_key["cg"]
-    dx = sel.params["cg"] * term.scale
+    test = shift_mistrim_test(p, sel.params["cg"] * by_key["cg"].scale, axis, selections, nuisances, mismatch,
+                              measured)
+    if test is not None and test.pinned:
+        test = test._replace(reason=test.reason + f", the mistrim of a {test.dx_ft:.3g} ± {test.std_error_ft:.2g} ft "
+                                                  "shift, named instead")
+    return test
+
+
+def shift_mistrim_test(p: Prepared, dx: float, axis: str, selections: dict, nuisances: dict,
+                       mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> CgMeanTest | None:
+    """A moment-reference shift of ``dx`` ft, read off ``axis``'s mismatch, against the mean
+    of C_m's mismatch beside C_m's entered terms (:func:`_cg_mean_test`, which applies it to
+    the shift the stepwise entered; :func:`harness.diagnosis.term_rules.withhold_rivals` to
+    a shift that would imitate another term). None when the mean of C_Z is zero."""
     inner = interior(p)
     cbar = p.meta["geometry"]["cbar_ft"]
     cz = float(np.mean(measured["CZ"][inner]))
@@ -250,8 +262,6 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     pinned = mean * np.sign(predicted) >= CG_MEAN_Z * mean_se
     reason = (f"refuted by the mean of C_m: the shift of {dx:.3g} ft the {axis} mismatch suggests would mistrim "
               f"C_m by {predicted:+.2g}; C_m's mismatch has a constant of {mean:+.2g} ± {mean_se:.1g}")
-    if pinned:
-        reason += f", the mistrim of a {dx_mean:.3g} ± {se_mean:.2g} ft shift, named instead"
     return CgMeanTest(True, reason, dx_mean, se_mean, bool(pinned), share, explained)
 
 

@@ -14,7 +14,7 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
 from harness.diagnosis.prepare import Prepared, clean_channels
 from harness.diagnosis.sensor_rules import AMBIGUOUS_T, kinematic_estimate, kinematic_std_error
-from harness.diagnosis.stepwise_axes import StepwiseFits
+from harness.diagnosis.stepwise_axes import StepwiseFits, shift_mistrim_test
 from models.aircraft import Aircraft
 from models.replay import InitialCondition
 
@@ -185,11 +185,13 @@ def kinematic_bias_of(kin: KinematicResult, channel: str, applied: set[str]) -> 
 
 
 def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
-                    p: Prepared, slope_of, kin: KinematicResult, applied: set[str], V0: float) -> None:
+                    p: Prepared, slope_of, kin: KinematicResult, applied: set[str], V0: float,
+                    measured: dict[str, np.ndarray]) -> None:
     """Deselect the aerodynamic terms the data cannot tell from a rival (:mod:`rivals`): a
     collinear candidate of the same axis, or a vane bias the kinematics cannot rule out. A
     term that survives keeps its strongest collinear rival in ``details['rival']`` for the
-    validation maneuver to judge."""
+    validation maneuver to judge. A moment-reference shift is no rival when the size it
+    would need is refuted by the mean of C_m (:func:`_refuted_shift`)."""
     inner = interior(p)
     for c in cands:
         if not c.selected or c.channel not in selections:
@@ -205,6 +207,12 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
         others = [n for n in sel.names if n != key and n in columns]
         others += [k for k in nuisances.get(c.channel, {}) if k in columns]
         rival = rivals.strongest_rival(z, columns, key, others, pool)
+        refuted = _refuted_shift(rival, by_key, c.channel, p, selections, nuisances, mismatch, measured)
+        if refuted:
+            c.details["refuted_rival"] = {"parameter": "dx_moment_reference", "effect": "cg_offset",
+                                          "correlation": rival.correlation, "t_term": rival.t_term,
+                                          "reason": refuted}
+            rival = rivals.strongest_rival(z, columns, key, others, [k for k in pool if k != rival.key])
         if rival is not None:
             rt = by_key[rival.key]
             c.details["rival"] = {"parameter": rt.parameter, "effect": rt.effect, "axis": c.channel,
@@ -229,6 +237,23 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                             f"imitate it through the model's nonlinearity (beside it, t = {b.t_term:.1f}), and the "
                             f"kinematics cannot rule that bias out ({_bias_text(b)})")
                 break
+
+
+def _refuted_shift(rival: rivals.Rival | None, by_key: dict, axis: str, p: Prepared, selections: dict,
+                   nuisances: dict, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> str:
+    """Why a moment-reference shift cannot be the rival it looks like, '' when it can (or the
+    rival is something else). A shift Δx is one parameter on two axes: the C_n it would
+    explain through C_Y (the C_Y column follows β, as C_n,β's does, on a lateral maneuver)
+    comes with a C_m of Δx·C_Z/c̄, whose mean a lateral maneuver still records. When that
+    mean falls short of what the shift needs (:func:`stepwise_axes.shift_mistrim_test`, the
+    test the stepwise's own shift must pass), the shift is refuted, not a rival."""
+    if rival is None or by_key[rival.key].effect != "cg_offset":
+        return ""
+    dx = rival.swapped * by_key[rival.key].scale
+    test = shift_mistrim_test(p, dx, axis, selections, nuisances, mismatch, measured)
+    if test is None or not test.refuted:
+        return ""
+    return test.reason
 
 
 def _bias_text(b: rivals.BiasRival) -> str:

@@ -85,7 +85,35 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
             out["reason"] = _ambiguous_reason(rival, ratio - 1.0)
         elif rival["indistinct"]:
             out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
+    if out["status"] == "confirmed":
+        why = unreplicated(av, f)
+        if why:
+            out["status"], out["reason"] = "ambiguous", why
     return out
+
+
+def unreplicated(av: Analysis, f: Candidate) -> str:
+    """Why a term the identification could not tell from a moment-reference shift, which the
+    mean of C_m then refuted (``details['refuted_rival']``, :func:`term_rules._refuted_shift`),
+    is not named: the validation maneuver's own fit does not enter it ('' when it does, or the
+    term had no such rival). Such a term stands on its own t alone, so it must stand on each
+    maneuver: the validation's stepwise estimate of the same parameter, of the identification's
+    sign, at |t| >= the entry t (:data:`candidates.T_IN`). A lowering of the validation RMS by
+    1 % is no test of it: a C_n,αβ coupling of 2 on a three-axis maneuver at 427.4 ft/s read as
+    a C_n,β change of −0.010 (t −6.3; the α of the lateral inputs lay below trim) lowered it by
+    1.6 %, and the validation's own fit gave t −4.0; a C_n,β change of +0.05 at 30,000 ft gave
+    t 29 and 12 (outside sweep and probe, 4 Dec 2026)."""
+    refuted = f.details.get("refuted_rival")
+    if not refuted or abs(refuted.get("t_term", 0.0)) >= cand.T_IN:
+        return ""
+    twin = next((c for c in av.candidates if c.effect == f.effect and c.parameter == f.parameter), None)
+    t_v = twin.t if twin is not None else 0.0
+    if np.sign(t_v) == np.sign(f.t) and abs(t_v) >= cand.T_IN:
+        return ""
+    return (f"the identification maneuver could not tell it from {refuted['parameter']} (columns correlated "
+            f"{refuted['correlation']:+.2f}; beside it, t = {refuted['t_term']:.1f}), whose size the mean of C_m "
+            f"refutes, so it rests on its own t; the validation maneuver's own fit gives t = {t_v:.1f} for it, under "
+            f"the entry t of {cand.T_IN:g}")
 
 
 def _mode_check(av: Analysis, f: Candidate) -> dict:
