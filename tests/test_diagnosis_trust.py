@@ -1106,3 +1106,42 @@ def test_a_term_whose_shift_rival_was_refuted_must_enter_on_the_validation_too()
     plain = Candidate(f.effect, f.axis, f.channel, f.parameter, f.estimate, f.std_error, f.t, 0.27, f.units, f.test,
                       True)
     assert unreplicated(validation(0.0), plain) == ""
+
+
+def test_a_shift_read_off_cn_is_set_apart_from_cn_beta_by_the_mistrim_of_cm():
+    """term_rules._shift_set_apart: a moment-reference shift entered on C_n (its C_Y column
+    follows β on a lateral maneuver, as C_n,β's does) is set apart from that rival when C_m's
+    constant carries the mistrim Δx·mean(C_Z)/c̄ it predicts, itself a shift of the same sign
+    CG_MEAN_Z standard errors from zero and practical; not without the mistrim, with one of the
+    other sign, or for a shift read off C_m or a term of another effect."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.term_rules import _shift_set_apart
+    rng = np.random.default_rng(7)
+    n, cbar, b, dx = 1500, 11.32, 30.0, 1.0
+    CZ = -0.4 + 0.005 * np.sin(np.linspace(0.0, 20.0, n))
+    CY = 0.02 * np.sin(np.linspace(0.0, 13.0, n))
+    p = SimpleNamespace(dt=0.02, n=n, meta={"geometry": {"cbar_ft": cbar, "b_ft": b}})
+    selections = {"Cm": (SimpleNamespace(names=(), params={}), {})}
+    measured = {"CZ": CZ, "CY": CY, "Cm": 0.01 * np.sin(np.linspace(0.0, 9.0, n))}
+    noise = 1e-4 * rng.standard_normal(n)
+    predicted = dx * float(np.mean(CZ)) / cbar                         # about −0.035
+    shift = Candidate("cg_offset", "yaw", "Cn", "dx_moment_reference", dx, 0.09, -11.2, 0.4, "ft",
+                      "stepwise on the Cn mismatch", True)
+
+    def apart(c, cm_constant):
+        return _shift_set_apart(c, p, selections, {}, {"Cm": cm_constant + noise}, measured)
+
+    why = apart(shift, predicted)
+    assert why.startswith("C_m's mean carries the mistrim") and "1 ft from the Cn mismatch" in why
+    assert apart(shift, 0.0) == ""                                     # no mistrim: refuted, not apart
+    assert apart(shift, -predicted) == ""                              # the other sign
+    on_cm = Candidate("cg_offset", "pitch", "Cm", "dx_moment_reference", dx, 0.09, 11.2, 0.4, "ft",
+                      "stepwise on the Cm mismatch", True)
+    assert apart(on_cm, predicted) == ""
+    cn_beta = Candidate("coefficient_error", "yaw", "Cn", "Cn_beta", 0.25, 0.002, 20.0, 0.4, "per rad",
+                        "stepwise on the Cn mismatch", True)
+    assert apart(cn_beta, predicted) == ""

@@ -458,3 +458,20 @@ def test_a_cn_beta_change_on_a_lateral_maneuver_is_not_taken_for_a_moment_refere
     f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
     assert f["evidence"]["refuted_rival"]["parameter"] == "dx_moment_reference"
     assert f["evidence"]["validation"]["status"] == "confirmed"
+
+
+def test_a_moment_reference_shift_on_a_lateral_maneuver_is_named_by_its_two_axes(tmp_path):
+    """A 1 ft moment-reference shift on a lateral maneuver at 10,000 ft / 420 ft/s (seed 14101,
+    not a sweep case). The shift's C_Y column in C_n follows β (correlation −0.92 with C_n,β's),
+    so the two could not be told apart on C_n and the finding was `ambiguous`: `none`. C_m's
+    constant carries the mistrim the shift predicts, which no C_n term explains
+    (term_rules._shift_set_apart): the shift is named, its size within 2 standard errors or
+    25 %, nothing else, the validation's r fit better by 30 % or more."""
+    from harness.diagnosis import outside_cases as oc
+    from harness.diagnosis.outside import run_case
+    c = oc.OutsideCase("S_lateral_cg_offset_dx_moment_reference_1", "S", "lateral", (oc.H("cg_offset", 1.0),),
+                       "cg_offset", "dx_moment_reference", 1.0, "r", seed=14101, drop=oc._drops(0))
+    row = run_case(c, tmp_path)
+    assert row["error"] is None and row["a"] and row["b"] and row["d"] and row["c"] == 0, (row["first"], row["false"])
+    f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
+    assert f["evidence"]["rival"]["set_apart"].startswith("C_m's mean carries the mistrim")

@@ -14,7 +14,7 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
 from harness.diagnosis.prepare import Prepared, clean_channels
 from harness.diagnosis.sensor_rules import AMBIGUOUS_T, kinematic_estimate, kinematic_std_error
-from harness.diagnosis.stepwise_axes import StepwiseFits, shift_mistrim_test
+from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test
 from models.aircraft import Aircraft
 from models.replay import InitialCondition
 
@@ -218,7 +218,10 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
             c.details["rival"] = {"parameter": rt.parameter, "effect": rt.effect, "axis": c.channel,
                                   "correlation": rival.correlation, "t_term": rival.t_term,
                                   "t_rival": rival.t_rival, "coefficient": rival.swapped}
-            if abs(rival.t_term) < cand.T_IN:
+            apart = _shift_set_apart(c, p, selections, nuisances, mismatch, measured)
+            if apart:
+                c.details["rival"]["set_apart"] = apart
+            elif abs(rival.t_term) < cand.T_IN:
                 # the identification maneuver cannot tell them apart: a finding only if the
                 # validation maneuver prefers it (validation.validation_check), never without one
                 c.details["rival"]["indistinct"] = (
@@ -254,6 +257,26 @@ def _refuted_shift(rival: rivals.Rival | None, by_key: dict, axis: str, p: Prepa
     if test is None or not test.refuted:
         return ""
     return test.reason
+
+
+def _shift_set_apart(c: Candidate, p: Prepared, selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
+                     measured: dict[str, np.ndarray]) -> str:
+    """Why a moment-reference shift read off C_n is set apart from its collinear rival (a C_n,β
+    change, whose column the shift's C_Y column follows on a lateral maneuver), '' when it
+    is not: the shift is one parameter on two axes, and C_m's mean carries the mistrim
+    Δx·mean(C_Z)/c̄ it predicts (:func:`stepwise_axes.shift_mistrim_test` does not refute it),
+    itself a shift of the same sign at least :data:`stepwise_axes.CG_MEAN_Z` standard errors
+    from zero and at least :data:`candidates.PRACTICAL_SHARE` of C_m's excursion. A C_n term
+    explains nothing of C_m's constant; a C_n,β error and a C_m₀ error of just the matching
+    size would have to coincide."""
+    if c.effect != "cg_offset" or c.channel != "Cn":
+        return ""
+    test = shift_mistrim_test(p, c.estimate, c.channel, selections, nuisances, mismatch, measured)
+    if (test is None or test.refuted or np.sign(test.dx_ft) != np.sign(c.estimate)
+            or abs(test.dx_ft) < CG_MEAN_Z * test.std_error_ft or test.share < cand.PRACTICAL_SHARE):
+        return ""
+    return (f"C_m's mean carries the mistrim the shift predicts: a shift of {test.dx_ft:.3g} ± "
+            f"{test.std_error_ft:.2g} ft, against {c.estimate:.3g} ft from the {c.channel} mismatch")
 
 
 def _bias_text(b: rivals.BiasRival) -> str:
