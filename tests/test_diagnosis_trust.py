@@ -1145,3 +1145,30 @@ def test_a_shift_read_off_cn_is_set_apart_from_cn_beta_by_the_mistrim_of_cm():
     cn_beta = Candidate("coefficient_error", "yaw", "Cn", "Cn_beta", 0.25, 0.002, 20.0, 0.4, "per rad",
                         "stepwise on the Cn mismatch", True)
     assert apart(cn_beta, predicted) == ""
+
+
+def test_a_still_surface_whose_end_samples_are_off_has_not_moved():
+    """prepare.interior_motion and maneuver_driven: the smoothed signal ends on the raw end
+    samples, so a surface still but for its noise, whose first and last samples happen to lie
+    two noise levels off in opposite directions, deviates from the line through its ends by
+    the line itself. Measured on the interior about its least-squares line it has not moved
+    (a pitch maneuver's aileron: a C_l,δa "finding" was the model's derivative times the
+    aileron's noise, taken back by the regression); a real doublet still has."""
+    import numpy as np
+
+    from harness.diagnosis.prepare import about_trend, interior_motion, interior_slice, maneuver_driven
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    rng = np.random.default_rng(11)
+    w = np.ones(n - 2) * 0.2
+    sigma = np.radians(0.05)
+    ramp = np.exp(-t / 0.2) - np.exp(-(t[-1] - t) / 0.2)       # ends pinned at -2 and +2 sigma
+    still = -2.0 * sigma * ramp + 0.2 * sigma * rng.standard_normal(n)
+    doublet = np.radians(1.0) * (np.sign(np.sin(np.pi * (t - 5.0))) * ((t > 5.0) & (t < 7.0)))
+    inner = interior_slice(n, dt)
+    assert inner == slice(50, n - 50)
+    assert about_trend(still) > 5.0 * 0.2 * sigma                # the old measure: 'moved'
+    assert interior_motion(still[inner]) < 0.5 * sigma
+    smooth = {"da": still[inner], "de": doublet[inner]}
+    noise = {"da": sigma, "de": sigma}
+    assert maneuver_driven(smooth, noise, w, excited=()) == ("de",)

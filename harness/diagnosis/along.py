@@ -12,7 +12,7 @@ import numpy as np
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles
-from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, measured_coefficients
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, interior_slice, measured_coefficients
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import AeroAlong, InitialCondition, aero_along
@@ -104,9 +104,8 @@ def inertial_beta(p: Prepared) -> bool:
 
 def interior(p: Prepared) -> slice:
     """The maneuver's interior: the first and last second are where the smoother is least
-    accurate."""
-    k = max(1, int(round(1.0 / p.dt)))
-    return slice(k, p.n - k)
+    accurate (:func:`prepare.interior_slice`)."""
+    return interior_slice(p.n, p.dt)
 
 
 def slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],

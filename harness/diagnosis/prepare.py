@@ -30,6 +30,10 @@ DRIVEN_BY = {"alpha": ("de",), "q": ("de",), "theta": ("de",), "V": ("de",),
 # A driven state's filtered signal must stand this many times above the white noise the
 # common filter lets through (sigma * sqrt(mean(w^2)), Parseval on the sine series).
 DRIVEN_SNR = 5.0
+# The first and last second of a record are where the sine-series smoother is least
+# accurate: it removes the line through the raw (noisy) end samples and returns to them. The
+# analysis works on the interior (:func:`interior_slice`), and motion is measured there.
+EDGE_S = 1.0
 # A state whose filtered signal stands this far above that noise moved, whatever moved it (a
 # lateral departure swings α by degrees with the stabilator still): drifted_states.
 SELF_EVIDENT_SNR = 25.0
@@ -200,6 +204,26 @@ def _channels(rec: Recording) -> dict[str, np.ndarray]:
     return out
 
 
+def interior_slice(n: int, dt: float) -> slice:
+    """The samples of an ``n``-sample record at step ``dt`` without its first and last
+    :data:`EDGE_S`."""
+    k = max(1, int(round(EDGE_S / dt)))
+    return slice(k, n - k)
+
+
+def interior_motion(x: np.ndarray) -> float:
+    """The standard deviation of ``x`` (a record's interior) about its least-squares line:
+    what moved inside the record. Not :func:`about_trend`: the smoothed signal ends on the raw
+    end samples, and two end samples off by two noise levels each, in opposite directions,
+    tilt the line through them by four (a pitch maneuver's aileron, still but for its 0.05°
+    noise, then 'moved' by 0.06° about that line, five times the noise the filter passes)."""
+    x = np.asarray(x, dtype=float)
+    if x.size < 3:
+        return 0.0
+    t = np.arange(x.size, dtype=float)
+    return float(np.std(x - np.polyval(np.polyfit(t, x, 1), t)))
+
+
 def about_trend(x: np.ndarray) -> float:
     """The standard deviation of ``x`` about the line through its end points: the signal the
     sine-series filter smooths (it removes that line first)."""
@@ -265,7 +289,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     except (KeyError, ValueError) as exc:
         raise ValueError(f"recording {rec.name!r} lacks mass properties Eqs. 1-5 need: {exc}") from exc
     measured = measured_coefficients(smooth, deriv, rec.meta, mass)
-    driven = maneuver_driven(smooth, noise, w, excited)
+    driven = maneuver_driven({c: x[interior_slice(t.size, dt)] for c, x in smooth.items()}, noise, w, excited)
     moved = drifted_states(smooth, noise, w, k, driven)
     own_noise = {c: np.asarray(f.noise) for c, f in fits.items()}
     if "h" in raw:
@@ -422,18 +446,20 @@ def filtered_noise_std(noise_std: float, weights: np.ndarray) -> float:
 
 def maneuver_driven(smooth: dict[str, np.ndarray], noise: dict[str, float], weights: np.ndarray,
                     excited: tuple[str, ...], snr: float = DRIVEN_SNR) -> tuple[str, ...]:
-    """The surfaces that moved and the states the maneuver drove.
+    """The surfaces that moved and the states the maneuver drove, from the record's interior
+    ``smooth`` (:func:`interior_slice`).
 
     A surface counts when it is ``excited`` (its smoothed signal at least 5 times its noise).
     A state counts when a surface of its group moved (:data:`DRIVEN_BY`: the lateral states
     need an aileron or rudder input, the longitudinal ones a stabilator input) *and* its
-    filtered, detrended signal stands ``snr`` times above the white noise the filter passes.
+    filtered signal, about its least-squares line (:func:`interior_motion`), stands ``snr``
+    times above the white noise the filter passes.
     Coloured sensor noise inside the band can pass the second test; the first is what keeps
     a pitch maneuver's β, p and r out of the analysis. A state that moved far without its
     group's input (a lateral input's spiral, turbulence) is not driven: the model is evaluated
     along it (:func:`drifted_states`), no term is built on it."""
     def ratio(c: str) -> float:
-        signal = about_trend(smooth[c])
+        signal = interior_motion(smooth[c])
         if signal < DRIVEN_FLOOR.get(c, 0.0):
             return 0.0
         return signal / max(filtered_noise_std(noise.get(c, 0.0), weights), 1e-12)
