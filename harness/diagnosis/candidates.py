@@ -15,7 +15,7 @@ import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
 from harness.diagnosis.kinematics import kinematic_alpha_rate
-from harness.diagnosis.prepare import Prepared, filtered_noise_std
+from harness.diagnosis.prepare import Prepared, filtered_noise_std, interior_slice
 from models.constants import SURFACES
 
 T_IN = 5.0
@@ -86,9 +86,9 @@ def effective_derivatives(p: Prepared, axis: str, model: np.ndarray) -> dict[str
              if r in reg and np.ptp(reg[r]) > 0]
     if not names:
         return {}
-    k = max(1, int(round(1.0 / p.dt)))
-    A = np.column_stack([reg[r][k:-k] for r in names] + [np.ones(p.n - 2 * k)])
-    theta, *_ = np.linalg.lstsq(A, model[k:-k], rcond=None)
+    inner = interior_slice(p.n, p.dt)
+    A = np.column_stack([reg[r][inner] for r in names] + [np.ones(inner.stop - inner.start)])
+    theta, *_ = np.linalg.lstsq(A, model[inner], rcond=None)
     return {f"{axis}_{r}": float(v) for r, v in zip(names, theta)}
 
 
@@ -178,8 +178,8 @@ def joint_excitation(p: Prepared) -> float:
     outside sweep's c172x three-axis maneuvers, where its α follows the lateral motion, 9-10;
     the project's coupled maneuver 19."""
     reg = regressors(p)
-    k = max(1, int(round(1.0 / p.dt)))
-    a, b = reg["alpha"][k:-k], reg["beta"][k:-k]
+    inner = interior_slice(p.n, p.dt)
+    a, b = reg["alpha"][inner], reg["beta"][inner]
     product = a * b
     X = np.column_stack([np.ones_like(a), a, b])
     rest = product - X @ np.linalg.lstsq(X, product, rcond=None)[0]
@@ -239,8 +239,7 @@ def delay_scan(p: Prepared, surface: str, mismatch: dict[str, np.ndarray], deriv
     if not axes:
         return None
     x = p.smooth[surface]
-    k = max(1, int(round(1.0 / p.dt)))
-    inner = slice(k, p.n - k)
+    inner = interior_slice(p.n, p.dt)
     sse = []
     for tau in DELAY_GRID_S:
         dx = _shift(x, tau, p.dt) - x
@@ -305,8 +304,7 @@ def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: di
     """Least squares of the stacked, noise-weighted force mismatches on the accelerometer
     position (with an intercept per axis), colored-residual standard errors."""
     cols = accelerometer_columns(p)
-    k = max(1, int(round(1.0 / p.dt)))
-    inner = slice(k, p.n - k)
+    inner = interior_slice(p.n, p.dt)
     axes = ("CX", "CY", "CZ")
     m = inner.stop - inner.start
     Z = np.concatenate([mismatch[c][inner] / noise[c] for c in axes])
@@ -328,8 +326,7 @@ def axis_selection(p: Prepared, axis: str, mismatch: np.ndarray, terms: list[Ter
                    forced: dict[str, np.ndarray] | None = None) -> ColoredSelection:
     """Forward selection of ``terms`` (plus ``extra`` columns, e.g. a delay) on the interior
     of one axis's mismatch; ``forced`` nuisance columns are in every fit."""
-    k = max(1, int(round(1.0 / p.dt)))
-    inner = slice(k, p.n - k)
+    inner = interior_slice(p.n, p.dt)
     cands = {t.key: t.column[inner] for t in terms}
     for key, col in (extra or {}).items():
         cands[key] = col[inner]

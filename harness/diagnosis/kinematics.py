@@ -23,7 +23,7 @@ from functools import partial
 import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_forward_selection
-from harness.diagnosis.prepare import Prepared, clean_channels
+from harness.diagnosis.prepare import Prepared, clean_channels, interior_slice
 from models.constants import G0_FPS2 as G0
 from models.hidden import vane_shift
 
@@ -259,8 +259,7 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
     ch = dict(p.raw)
     clean = clean_channels(p)
     # The first and last second are where the sine-series filter is least accurate.
-    k = max(1, int(round(1.0 / p.dt)))
-    inner = slice(k, p.n - k)
+    inner = interior_slice(p.n, p.dt)
     e0 = kinematic_residuals(ch, p)
     eqs = tuple(e0)
     weights = {e: 1.0 / max(float(np.std(e0[e][inner] - np.mean(e0[e][inner]))), 1e-12) for e in eqs}

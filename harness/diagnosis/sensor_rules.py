@@ -15,7 +15,7 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import NOT_IN_TURBULENCE
 from harness.diagnosis.kinematics import KinematicResult, channel_share, is_plausible, is_practical, kinematic_check
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
-from harness.diagnosis.prepare import Prepared, clean_channels
+from harness.diagnosis.prepare import Prepared, clean_channels, interior_slice
 from harness.diagnosis.stepwise_axes import practical_size
 from models.aircraft import Aircraft
 from models.replay import InitialCondition
@@ -339,8 +339,7 @@ def kinematic_share(kin: KinematicResult, name: str, value: float, p: Prepared) 
     aerodynamic terms (a noise-free flight asks for a 2 ft β-vane offset at t = 69, a
     0.01 deg change in β)."""
     clean = clean_channels(p)
-    k = max(1, int(round(1.0 / p.dt)))
-    return channel_share(kin.parameters[name], value, clean, p, slice(k, p.n - k))
+    return channel_share(kin.parameters[name], value, clean, p, interior_slice(p.n, p.dt))
 
 
 def kinematic_t(kin: KinematicResult, name: str) -> float:

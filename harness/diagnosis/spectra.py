@@ -9,7 +9,7 @@ import numpy as np
 from scipy import ndimage, signal, stats
 
 from estimators.colored_stepwise import colored_fit
-from harness.diagnosis.prepare import Prepared
+from harness.diagnosis.prepare import Prepared, interior_slice
 from models.constants import SURFACES
 
 MODE_CHANNELS = ("p", "q", "r", "ax", "ay", "az")
@@ -300,13 +300,13 @@ def gust_estimate(kin_residuals: dict[str, np.ndarray], p: Prepared, noise_accel
     turbulence the air-relative velocity differs from the inertial one by the gust, so
     E_w ≈ ẇ_gust; its integral (high-passed at 0.05 Hz to drop sensor-bias drift) is the gust."""
     b, a = signal.butter(2, GUST_HIGHPASS_HZ, btype="highpass", fs=1.0 / p.dt)
-    k = max(1, int(round(1.0 / p.dt)))
+    inner = interior_slice(p.n, p.dt)
 
     def gust(e: np.ndarray) -> np.ndarray:
         # E = d(air-relative)/dt - d(inertial)/dt = -d(air-mass velocity)/dt, body axes
         return -signal.filtfilt(b, a, np.cumsum(e) * p.dt)
     gw, gv = gust(kin_residuals["w"]), gust(kin_residuals.get("v", np.zeros(p.n)))
-    sw, sv = float(np.std(gw[k:-k])), float(np.std(gv[k:-k]))
+    sw, sv = float(np.std(gw[inner])), float(np.std(gv[inner]))
     # what white sensor noise alone gives: the operator (integrate, high-pass) is nearly
     # time-invariant, so the variance it passes is σ² times the energy of its response to
     # one impulse (mid-record, away from the ends) -- no random draw needed
@@ -353,8 +353,7 @@ def air_share(angle_difference: np.ndarray, slope: np.ndarray, mismatch: np.ndar
     last second are left out, where the filters start.
     """
     b, a = signal.butter(2, GUST_HIGHPASS_HZ, btype="highpass", fs=1.0 / dt)
-    k = max(1, int(round(1.0 / dt)))
-    inner = slice(k, len(mismatch) - k)
+    inner = interior_slice(len(mismatch), dt)
     def hp(x: np.ndarray) -> np.ndarray:
         return signal.filtfilt(b, a, np.asarray(x, dtype=float))[inner]
     e = np.asarray(angle_difference, dtype=float)
