@@ -242,6 +242,36 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                 break
 
 
+def note_untested_coupling(cands: list[Candidate], not_offered: dict, p: Prepared) -> None:
+    """Say, on a named β derivative, that an α·β coupling would read as it when the coupling
+    could not be tested (``not_offered``: α and β never moved together). Then (α − α₀)β is β
+    times the α the sideslip was flown at, and a coupling k reads as a β-derivative change of
+    k·Δα, Δα the β²-weighted mean of α − α₀ over the interior: the caveat gives that Δα and
+    the k the change would take (probe 15: a C_l α·β coupling of −2 read as C_l,β +0.014 at
+    Δα −0.58°). Only a maneuver moving α and β together tells them apart."""
+    inner = interior(p)
+    reg = cand.regressors(p)
+    a, b = reg["alpha"][inner], reg["beta"][inner]
+    weight = float(np.sum(b ** 2))
+    if weight <= 0.0:
+        return
+    offset = float(np.sum(b ** 2 * a)) / weight
+    for c in cands:
+        if not (c.selected and c.effect == "coefficient_error" and c.parameter == f"{c.channel}_beta"):
+            continue
+        untested = any(x["parameter"] == f"{c.channel}_alpha_beta" and "never moved together" in x.get("reason", "")
+                       for x in not_offered.get(c.channel, []))
+        change = c.details.get("change", 0.0)
+        if not untested or offset == 0.0 or not change:
+            continue
+        c.details["coupling_alternative"] = {"alpha_offset_rad": offset, "coupling": change / offset}
+        caveat = (f"α and β never moved together here, so a {c.channel} α·β coupling of {change / offset:.3g} per "
+                  f"rad² would read as this change (the sideslip was flown {np.degrees(offset):+.2f}° of α from "
+                  "the start); only a maneuver moving α and β together tells the two apart")
+        prior = c.details.get("not_ruled_out")
+        c.details["not_ruled_out"] = f"{prior}; {caveat}" if prior else caveat
+
+
 def _refuted_shift(rival: rivals.Rival | None, by_key: dict, axis: str, p: Prepared, selections: dict,
                    nuisances: dict, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> str:
     """Why a moment-reference shift cannot be the rival it looks like, '' when it can (or the
