@@ -1175,10 +1175,11 @@ def test_a_still_surface_whose_end_samples_are_off_has_not_moved():
 
 
 def test_a_beta_derivative_says_an_untested_coupling_would_read_as_it(monkeypatch):
-    """term_rules.note_untested_coupling: where the α·β coupling was not offered because α and
-    β never moved together, a named β derivative carries the caveat that a coupling k reads as
-    its change at the α the sideslip was flown at, k = change / Δα, Δα the β²-weighted mean of
-    α − α₀; not where the coupling was offered, nor on other terms."""
+    """term_rules.note_untested_coupling: where α and β were both driven but never moved
+    together (candidates.joint_excitation under JOINT_SNR, so no α·β coupling was offered), a
+    named β derivative carries the caveat that a coupling k reads as its change at the α the
+    sideslip was flown at, k = change / Δα, Δα the β²-weighted mean of α − α₀; not where they
+    moved together or α was not driven, nor on other terms."""
     from types import SimpleNamespace
 
     import numpy as np
@@ -1191,19 +1192,25 @@ def test_a_beta_derivative_says_an_untested_coupling_would_read_as_it(monkeypatc
     beta = np.radians(2.0) * np.sin(2 * np.pi * 0.4 * t) * (t > 15.0)
     alpha = np.radians(-0.5) * (t > 14.0)                     # the lateral inputs flown 0.5 deg low
     monkeypatch.setattr(cand, "regressors", lambda p: {"alpha": alpha, "beta": beta})
-    p = SimpleNamespace(n=n, dt=dt)
+    together = {"value": cand.JOINT_SNR - 2.0}
+    monkeypatch.setattr(cand, "joint_excitation", lambda p: together["value"])
+    p = SimpleNamespace(n=n, dt=dt, driven=("de", "da", "dr", "alpha", "beta", "q", "p", "r"))
 
     def named(parameter, channel="Cl"):
         return Candidate("coefficient_error", "roll", channel, parameter, -0.124, 0.002, 7.7, 0.4, "per rad",
                          f"stepwise on the {channel} mismatch", True, details={"change": 0.0144})
 
-    untested = {"Cl": [{"effect": "cross_coupling", "parameter": "Cl_alpha_beta", "sources": ["alpha", "beta"],
-                        "reason": "α and β never moved together: ..."}]}
     c, other = named("Cl_beta"), named("Cl_phat")
-    note_untested_coupling([c, other], untested, p)
+    note_untested_coupling([c, other], p)
     k = c.details["coupling_alternative"]["coupling"]
     assert abs(k - 0.0144 / np.radians(-0.5)) < 1e-9 and "-0.50° of α" in c.details["not_ruled_out"]
     assert "coupling_alternative" not in other.details
+    together["value"] = cand.JOINT_SNR + 1.0                  # they moved together: the coupling was offered
     offered = named("Cl_beta")
-    note_untested_coupling([offered], {"Cl": []}, p)
+    note_untested_coupling([offered], p)
     assert "not_ruled_out" not in offered.details
+    lateral = SimpleNamespace(n=n, dt=dt, driven=("da", "dr", "beta", "p", "r"))
+    together["value"] = 0.0
+    alone = named("Cl_beta")
+    note_untested_coupling([alone], lateral)                  # α not driven: no term is built on it
+    assert "not_ruled_out" not in alone.details

@@ -83,7 +83,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
                     measured)
-    note_untested_coupling(cands, step.not_offered, p)
+    note_untested_coupling(cands, p)
     withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step))
     if turbulent:
         withhold_in_turbulence(cands)

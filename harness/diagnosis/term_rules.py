@@ -242,13 +242,17 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                 break
 
 
-def note_untested_coupling(cands: list[Candidate], not_offered: dict, p: Prepared) -> None:
+def note_untested_coupling(cands: list[Candidate], p: Prepared) -> None:
     """Say, on a named β derivative, that an α·β coupling would read as it when the coupling
-    could not be tested (``not_offered``: α and β never moved together). Then (α − α₀)β is β
+    could not be tested because α and β, both driven, never moved together (the test of
+    :func:`candidates.offered`: :func:`candidates.joint_excitation` under
+    :data:`candidates.JOINT_SNR`). Then (α − α₀)β is β
     times the α the sideslip was flown at, and a coupling k reads as a β-derivative change of
     k·Δα, Δα the β²-weighted mean of α − α₀ over the interior: the caveat gives that Δα and
     the k the change would take (probe 15: a C_l α·β coupling of −2 read as C_l,β +0.014 at
     Δα −0.58°). Only a maneuver moving α and β together tells them apart."""
+    if not {"alpha", "beta"} <= set(p.driven) or cand.joint_excitation(p) >= cand.JOINT_SNR:
+        return
     inner = interior(p)
     reg = cand.regressors(p)
     a, b = reg["alpha"][inner], reg["beta"][inner]
@@ -259,10 +263,8 @@ def note_untested_coupling(cands: list[Candidate], not_offered: dict, p: Prepare
     for c in cands:
         if not (c.selected and c.effect == "coefficient_error" and c.parameter == f"{c.channel}_beta"):
             continue
-        untested = any(x["parameter"] == f"{c.channel}_alpha_beta" and "never moved together" in x.get("reason", "")
-                       for x in not_offered.get(c.channel, []))
         change = c.details.get("change", 0.0)
-        if not untested or offset == 0.0 or not change:
+        if offset == 0.0 or not change:
             continue
         c.details["coupling_alternative"] = {"alpha_offset_rad": offset, "coupling": change / offset}
         caveat = (f"α and β never moved together here, so a {c.channel} α·β coupling of {change / offset:.3g} per "
