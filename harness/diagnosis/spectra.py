@@ -22,7 +22,7 @@ INPUT_LINE_P = 1e-3
 # (F(dof, dof), :func:`echoes`).
 ECHO_P = 0.05
 # The surfaces that drive each channel a mode is sought in (an echo needs its input).
-DRIVEN_BY = {"q": ("de",), "ax": ("de",), "az": ("de",), "p": ("da", "dr"), "r": ("da", "dr"), "ay": ("da", "dr")}
+MODE_DRIVERS = {"q": ("de",), "ax": ("de",), "az": ("de",), "p": ("da", "dr"), "r": ("da", "dr"), "ay": ("da", "dr")}
 # The other maneuver's spectrum, at a mode frequency one record found (p < FISHER_P), shows
 # the mode too at this level (:func:`peak_at`: three ordinates at a frequency given in advance).
 MODE_CONFIRM_P = 0.01
@@ -129,7 +129,7 @@ def predicted_peak_p(p: Prepared, pv: Prepared, channel: str, frequency_hz: floa
                      half_width_hz: float = 2.5) -> float:
     """How clearly record ``p`` should show the mode record ``pv`` shows on ``channel`` at
     ``frequency_hz``, had it rung it: ``pv``'s excess over its running median there, scaled
-    by how much less power the surfaces driving the channel (:data:`DRIVEN_BY`) carry at that
+    by how much less power the surfaces driving the channel (:data:`MODE_DRIVERS`) carry at that
     frequency in ``p`` than in ``pv`` (the largest ratio over them, within a bin, of the power
     above each surface's white sensor floor, the median of its top band, 0.7-0.9 of Nyquist: a
     mode rings in proportion to its input's power at its frequency), over ``p``'s own median;
@@ -139,7 +139,7 @@ def predicted_peak_p(p: Prepared, pv: Prepared, channel: str, frequency_hz: floa
     both."""
     if untestable_at(p, channel, frequency_hz, segment_s) or untestable_at(pv, channel, frequency_hz, segment_s):
         return float("nan")
-    surfaces = [s for s in DRIVEN_BY.get(channel, ()) if s in p.raw and s in pv.raw]
+    surfaces = [s for s in MODE_DRIVERS.get(channel, ()) if s in p.raw and s in pv.raw]
     if not surfaces:
         return float("nan")
 
@@ -219,7 +219,7 @@ def echoes(ratio: np.ndarray, idx: np.ndarray, channel: str, lines: dict[str, np
            dof: float) -> np.ndarray:
     """Which peaks (ordinates ``idx`` of ``channel``, standing ``ratio`` times above their
     running median) are echoes of an input's line: a surface that drives the channel
-    (:data:`DRIVEN_BY`) carries a line there (:func:`input_lines`), and the peak stands no
+    (:data:`MODE_DRIVERS`) carries a line there (:func:`input_lines`), and the peak stands no
     further above its median than the line does, within the scatter of two independent
     spectral estimates (the ratio of the two ratios tested as F(dof, dof) at
     :data:`ECHO_P`). The rigid body passes an input's line on to the output with a transfer
@@ -230,7 +230,7 @@ def echoes(ratio: np.ndarray, idx: np.ndarray, channel: str, lines: dict[str, np
     flexible mode rings far above the line that excites it (an F-16's 8 Hz mode at 2.9 times
     its median on a 1.8 times stabilator line)."""
     out = np.zeros(idx.size, dtype=bool)
-    for s in DRIVEN_BY.get(channel, ()):
+    for s in MODE_DRIVERS.get(channel, ()):
         line = lines.get(s)
         if line is None:
             continue
@@ -354,6 +354,7 @@ def air_share(angle_difference: np.ndarray, slope: np.ndarray, mismatch: np.ndar
     """
     b, a = signal.butter(2, GUST_HIGHPASS_HZ, btype="highpass", fs=1.0 / dt)
     inner = interior_slice(len(mismatch), dt)
+
     def hp(x: np.ndarray) -> np.ndarray:
         return signal.filtfilt(b, a, np.asarray(x, dtype=float))[inner]
     e = np.asarray(angle_difference, dtype=float)

@@ -215,7 +215,7 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     elif both:  # named on the two maneuvers
         text += (f" The identification maneuver rings it too weakly to name alone (p = {both['identification_p']:.2g} "
                  f"at that frequency); the validation maneuver's peak (p = {both['validation_p']:.2g}) names it.")
-    if c.details.get("not_ruled_out"):  # an assumption the result rests on (term_rules._withhold_skewed_delay)
+    if c.details.get("not_ruled_out"):  # an assumption it rests on (term_rules: a skewed delay, an untested coupling)
         text += f" Caveat: {c.details['not_ruled_out']}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
     evidence.update({k: v for k, v in c.details.items() if k not in ("model_value",)})
