@@ -11,12 +11,12 @@ import jsbsim
 import numpy as np
 from scipy.optimize import least_squares
 
-from models.aircraft import TRIM_MOMENT_PROPERTIES, Aircraft, is_turboprop, model_xml, place_reference_point
+from models.aircraft import (TRIM_MOMENT_PROPERTIES, Aircraft, AircraftError, is_turboprop, is_xml_model, model_xml,
+                             place_reference_point)
 from models.conditions import FlightCondition
 from models.configuration import (SCHEDULED_SURFACES, command_configuration, configuration_record,
                                   cruise_configuration, place_configuration)
 from models.constants import G0_FPS2
-
 
 
 class TrimError(RuntimeError):
@@ -168,6 +168,22 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
                            configuration=configuration_record(fdm, config, written), held=held, method=method)
 
 
+def _first_run_ic(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> None:
+    """The instance's first ``run_ic``. An aircraft given by path whose own XML JSBSim cannot
+    initialise is bad input, refused with JSBSim's reason (AircraftError): the package's
+    fokker50 and f104 read properties only FlightGear defines
+    (``/controls/engines/engine/throttle``, ``systems/radar/range``). For the project's own
+    models such a failure is a bug and keeps its traceback."""
+    try:
+        fdm.run_ic()
+    except jsbsim.BaseError as exc:
+        if not is_xml_model(aircraft.model) or isinstance(exc, jsbsim.TrimFailureError):
+            raise
+        raise AircraftError(f"{aircraft.model}: JSBSim cannot initialise this aircraft as it stands "
+                            f"(JSBSim: {str(exc).strip()}): its XML reads something JSBSim alone does not define "
+                            "(FlightGear may); the diagnosis needs a model JSBSim can fly by itself") from exc
+
+
 def _initialise_in_cruise(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition):
     """Initial condition, cruise configuration (:mod:`models.configuration`) and running
     engines; returns the configuration and the properties written."""
@@ -175,7 +191,7 @@ def _initialise_in_cruise(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: 
     config = cruise_configuration(model_xml(aircraft.model))
     written = command_configuration(fdm, config)
     fdm["propulsion/set-running"] = -1
-    fdm.run_ic()
+    _first_run_ic(fdm, aircraft)
     # again after run_ic: it re-initialises some piston engines stopped (JSBSim 1.3: the c310's
     # and c182's), and a stopped engine leaves trim no equilibrium to find; for an engine
     # already running the property does nothing

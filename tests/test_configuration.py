@@ -169,3 +169,17 @@ def test_piston_engines_run_through_the_trim(name, condition):
     assert sum(fdm[f"propulsion/engine[{i}]/thrust-lbs"] for i in engines) > 100.0
     assert tp.method == "jsbsim"
     assert abs(fdm["accelerations/udot-ft_sec2"]) < 1e-2 and abs(fdm["accelerations/wdot-ft_sec2"]) < 1e-2
+
+
+@pytest.mark.parametrize("name, needle", [("fokker50", "/controls/engines/engine/throttle"),
+                                          ("f104", "systems/radar/range")])
+def test_a_package_aircraft_jsbsim_cannot_initialise_is_refused_by_name(name, needle):
+    """The package's fokker50 and f104 read properties JSBSim alone does not define; their
+    first run_ic fails inside JSBSim. Given by path, that is bad input (AircraftError, the CLI's
+    exit 2 with one message), not an internal error."""
+    from models.aircraft import AircraftError
+    path = f"{jsbsim.get_default_root_dir()}/aircraft/{name}/{name}.xml"
+    aircraft = Aircraft(path)
+    with pytest.raises(AircraftError, match="JSBSim cannot initialise") as err:
+        trim(load_fdm(aircraft, 1 / 120), aircraft, parse_condition("h=10000,V=350"))
+    assert needle in str(err.value) and path in str(err.value)
