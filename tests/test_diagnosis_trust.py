@@ -1214,3 +1214,30 @@ def test_a_beta_derivative_says_an_untested_coupling_would_read_as_it(monkeypatc
     alone = named("Cl_beta")
     note_untested_coupling([alone], lateral)                  # α not driven: no term is built on it
     assert "not_ruled_out" not in alone.details
+
+
+def test_the_inertial_sideslip_gets_the_common_filter_like_every_other_state(monkeypatch):
+    """along.model_states: the measured coefficients and every other state pass through the
+    recording's common filter, so the inertial sideslip the model follows must too (the
+    equation holds between quantities of one bandwidth). Unfiltered, on an F-16 lateral
+    maneuver at 3,000 ft / 260 ft/s (α 11°, common cut-off 0.3-0.7 Hz, where the Dutch roll
+    is), the C_l mismatch followed β at +0.030 per rad where C_l,β was 0.03 low (true
+    change −0.03): the model's full-bandwidth β against the filtered C_l. Here a stand-in
+    filter halves every record and the inertial angle is a 0.6 Hz sine: the state is the
+    halved sine, as the smoothed vane is."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis import along
+    n, dt = 1000, 0.02
+    t = np.arange(n) * dt
+    sine = 0.01 * np.sin(2 * np.pi * 0.6 * t)
+    ones = np.ones(n)
+    raw = {c: ones.copy() for c in along.INERTIAL_CHANNELS}
+    p = SimpleNamespace(smooth={k: 0.5 * raw[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta")},
+                        driven=("beta", "p", "r"), moved=(), start={k: 0.5 for k in raw}, n=n, raw=raw, own_noise={},
+                        altitude=None, filt=lambda x: 0.5 * np.asarray(x))
+    monkeypatch.setattr(along, "inertial_angles", lambda ch, src: {"alpha": ones, "beta": sine})
+    states, _ = along.model_states(p)
+    assert np.allclose(states["beta"], 0.5 * sine, rtol=0, atol=1e-15)
+    # the vane's own sideslip (vane_beta) stays the smoothed record
+    assert np.array_equal(along.model_states(p, vane_beta=True)[0]["beta"], p.smooth["beta"])
