@@ -19,6 +19,7 @@ metadata can say it (``meta['simulation']['configuration']``).
 """
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -64,7 +65,13 @@ class Configuration:
 
 
 def has_retractable_gear(xml_path: Path) -> bool:
-    """Whether an aircraft XML declares any retractable landing-gear contact."""
+    """Whether an aircraft XML declares any retractable landing-gear contact (read once per
+    file version: the parse was a fifth of a trim's time)."""
+    return _retractable_gear(str(xml_path), Path(xml_path).stat().st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=64)
+def _retractable_gear(xml_path: str, _mtime_ns: int) -> bool:
     root = ET.parse(xml_path).getroot()
     for contact in root.iter("contact"):
         flag = contact.find("retractable")
@@ -111,7 +118,6 @@ def configuration_record(fdm: jsbsim.FGFDMExec, config: Configuration, written: 
         "set": dict(written),
         "positions": {p: float(fdm[p]) for p in REPORTED_POSITIONS if pm.hasNode(p)},
     }
-
 
 
 # Surfaces an aircraft's FCS schedules discontinuously (switches with no hysteresis): their
