@@ -1241,3 +1241,14 @@ def test_the_inertial_sideslip_gets_the_common_filter_like_every_other_state(mon
     assert np.allclose(states["beta"], 0.5 * sine, rtol=0, atol=1e-15)
     # the vane's own sideslip (vane_beta) stays the smoothed record
     assert np.array_equal(along.model_states(p, vane_beta=True)[0]["beta"], p.smooth["beta"])
+
+
+def test_the_smallest_delay_named_is_a_time_and_at_least_one_and_a_half_samples():
+    """stepwise_axes.practical_delay: 40 ms (three times the 13 ms a noise-free self-check
+    shows at 50 Hz) and no less than 1.5 samples: 40 ms at 50, 100 and 200 Hz (two samples
+    gave 10 ms at 200 Hz, where a self-check shows 5 ms), 60 ms at 25 Hz and 75 ms at 20 Hz
+    (two samples gave 100 ms, over an 80 ms actuator delay)."""
+    from harness.diagnosis.stepwise_axes import practical_delay
+    for rate, floor in ((50.0, 0.04), (100.0, 0.04), (200.0, 0.04), (25.0, 0.06), (20.0, 0.075)):
+        assert practical_delay(1.0 / rate) == pytest.approx(floor)
+    assert practical_delay(1.0 / 20.0) < 0.08 < 2.0 / 20.0

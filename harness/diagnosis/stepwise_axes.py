@@ -294,9 +294,23 @@ def practical_size(name: str, dt: float) -> float:
     return PRACTICAL["offset_ft"]
 
 
-# The smallest transport delay worth naming, in samples: below it a delay cannot be told from
-# sample timing (JSBSim-flown recordings show about +0.6 sample on every null flight).
-PRACTICAL_DELAY_SAMPLES = 2.0
+# The smallest transport delay worth naming: PRACTICAL_DELAY_S, and at least
+# PRACTICAL_DELAY_SAMPLES samples (practical_delay). Below it a delay cannot be told from the
+# timing of the flown recordings themselves: the noise-free self-checks of the outside sweep
+# show up to 13.1 ms at 50 Hz (0.65 sample: the 737's rudder and aileron, the DHC-6's
+# aileron), 4.9 ms at 200 Hz (1 sample), none at 20 Hz; noisy nulls up to 12.9 ms at 20 Hz.
+# Two samples, the rule until 4 Dec 2026, was the same 40 ms at 50 Hz but 100 ms at 20 Hz,
+# where an 80 ms stabilator delay on the c172x (estimated 85 ms, t 35) went unnamed, and 10 ms
+# at 200 Hz, twice a self-check's.
+PRACTICAL_DELAY_S = 0.04
+PRACTICAL_DELAY_SAMPLES = 1.5
+
+
+def practical_delay(dt: float) -> float:
+    """The smallest transport delay named (s) at sample interval ``dt``: three times the
+    largest a noise-free self-check shows, and no less than :data:`PRACTICAL_DELAY_SAMPLES`
+    samples (the self-checks reach one sample at 200 Hz)."""
+    return max(PRACTICAL_DELAY_S, PRACTICAL_DELAY_SAMPLES * dt)
 
 
 def _practical(share: float) -> bool:
@@ -341,14 +355,15 @@ def aero_candidates(selections: dict, delays: dict, dt: float,
         best = max(rows, key=lambda r: abs(r[1].t))[1]
         entered = any(t.selected and _practical(shares.get((a, t.name), 0.0)) for a, t in rows)
         inside = scan.tau_s <= cand.DELAY_GRID_S[-1]
-        sel = entered and inside and scan.tau_s >= PRACTICAL_DELAY_SAMPLES * dt
+        sel = entered and inside and scan.tau_s >= practical_delay(dt)
         gain = max(t.gain for _, t in rows)
         out.append(Candidate("control_delay", "pitch" if s == "de" else ("roll" if s == "da" else "yaw"), s, f"tau_{s}",
                              scan.tau_s, scan.std_error, best.t, gain, "s", f"delay scan of {s} + stepwise", sel,
                              "entered" if sel else ("not entered" if not entered else
                                                     "entered, but the delay lies beyond the scanned 0-0.3 s: not an "
                                                     "actuator delay" if not inside else
-                                                    "entered, but under two samples"),
+                                                    f"entered, but under {1e3 * practical_delay(dt):.0f} ms, "
+                                                    "the smallest delay named"),
                              {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
     if cg_seen:
         axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))
