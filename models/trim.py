@@ -181,7 +181,7 @@ def _first_run_ic(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> None:
             raise
         raise AircraftError(f"{aircraft.model}: JSBSim cannot initialise this aircraft as it stands "
                             f"(JSBSim: {str(exc).strip()}): its XML reads something JSBSim alone does not define "
-                            "(FlightGear may); the diagnosis needs a model JSBSim can fly by itself") from exc
+                            "(FlightGear may); sidbench needs a model JSBSim can fly by itself") from exc
 
 
 def _initialise_in_cruise(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition):
