@@ -1252,3 +1252,24 @@ def test_the_smallest_delay_named_is_a_time_and_at_least_one_and_a_half_samples(
     for rate, floor in ((50.0, 0.04), (100.0, 0.04), (200.0, 0.04), (25.0, 0.06), (20.0, 0.075)):
         assert practical_delay(1.0 / rate) == pytest.approx(floor)
     assert practical_delay(1.0 / 20.0) < 0.08 < 2.0 / 20.0
+
+
+def test_a_heading_recorded_wrapped_is_read_as_the_continuous_angle(tmp_path):
+    """A heading in [0, 2π) that crosses north steps by 2π (recording-format.md fixes ψ's
+    unit, not its range). The diagnosis reads the bank and heading unwrapped
+    (prepare.WRAPPED_ANGLES): the same noise level and the same smoothed motion as the
+    heading recorded continuous (before, the step made ψ's noise level 2.2 rad)."""
+    from harness.diagnosis.gallery import case, write_case
+    from harness.diagnosis.prepare import prepare
+    from harness.recording_io import read_recording
+    rec = read_recording(write_case(case("none"), tmp_path, seed=3)["identification"])
+    t = rec.data["t_s"].to_numpy()
+    psi = rec.data["psi_rad"].to_numpy() + np.linspace(-0.05, 0.05, t.size)  # a turn through north
+    rec.data["psi_rad"] = psi
+    continuous = prepare(rec)
+    rec.data["psi_rad"] = np.mod(psi, 2.0 * np.pi)
+    assert np.ptp(rec.data["psi_rad"]) > 6.0
+    wrapped = prepare(rec)
+    assert wrapped.noise_std["psi"] == pytest.approx(continuous.noise_std["psi"], rel=1e-9)
+    shift = wrapped.smooth["psi"] - continuous.smooth["psi"]
+    assert np.allclose(shift, 2.0 * np.pi * round(shift[0] / (2.0 * np.pi)), rtol=0, atol=1e-9)

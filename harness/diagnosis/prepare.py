@@ -195,12 +195,23 @@ def instruments_at_cg(rec: Recording) -> Recording:
     return accelerometer_to_cg(vanes_at_cg(rec))
 
 
+# Euler angles a recording may give wrapped (recording-format.md fixes the unit, not the
+# range): a heading in [0, 2π) crosses north as a 2π step, one in (−π, π] crosses south.
+# θ stays within ±π/2 and is never wrapped.
+WRAPPED_ANGLES = ("phi", "psi")
+
+
 def _channels(rec: Recording) -> dict[str, np.ndarray]:
+    """The canonical channels the diagnosis reads, the bank and heading unwrapped
+    (:data:`WRAPPED_ANGLES`): a 2π step smoothed is a ramp the kinematics and the gust's
+    rotation to north-east-down would read as motion (a heading near north, recorded in
+    [0, 2π), gave ψ a noise level of 2.2 rad)."""
     out = {}
     for q, unit in UNITS.items():
         col = f"{q}_{unit}"
         if col in rec.data.columns:
-            out[q] = rec.data[col].to_numpy(dtype=float)
+            x = rec.data[col].to_numpy(dtype=float)
+            out[q] = np.unwrap(x) if q in WRAPPED_ANGLES else x
     return out
 
 
