@@ -24,7 +24,18 @@ FORMAT_ID = "flight-recording/1"
 """Value required in ``meta['format']``."""
 
 TIME_JITTER_TOL = 1e-6
-"""Largest accepted relative deviation of a time step from the mean step."""
+"""Largest accepted relative deviation of a time step from the mean step (beyond the rounding
+of the written times, :data:`TIME_ROUNDING_MAX_STEP_SHARE`)."""
+
+TIME_ROUNDING_MAX_STEP_SHARE = 0.05
+"""The coarsest rounding of written times read as uniform: half the written resolution at most
+this share of a step. Times a ``%.8g`` export wrote at 60 or 120 Hz (16.016667 s) deviate from
+the uniform grid by up to half their last decimal, 3e-5 of a 60 Hz step at 16 s and 3e-4 at
+160 s, though the samples were uniform; each such time is within half its own last written unit
+of the grid :func:`uniform_to_written_precision` fits. At 5 % of a step the labels are off by a
+twentieth of a sample, far below the smallest time effect the diagnosis names (1.5 samples)."""
+
+_FINEST_DECIMAL = 12  # 1e-12 s: below it a float64 time carries no written decimal to find
 
 GEOMETRY_KEYS: tuple[str, ...] = ("S_ft2", "b_ft", "cbar_ft")
 """Keys required in ``meta['geometry']`` (positive, finite)."""
@@ -131,6 +142,41 @@ def _check_columns(rec: Recording, src: str) -> None:
             )
 
 
+def written_resolution(t: np.ndarray) -> np.ndarray:
+    """Per sample, the coarsest unit its value is a whole multiple of: a power of ten down to
+    1e-12 s (the last decimal a text export wrote: 16.016667 gives 1e-6) or, for a value single
+    precision holds exactly, its single-precision spacing; 0 where neither shows.
+
+    An upper bound on the rounding each written time carries (a time that ends in zeros,
+    16.5, shows 0.1 though it was written to 1e-6; its deviation from the grid is then
+    small anyway)."""
+    t = np.asarray(t, dtype=float)
+    units = 10.0 ** -np.arange(0, _FINEST_DECIMAL + 1, dtype=float)
+    x = t[:, None] / units[None, :]
+    whole = np.abs(x - np.rint(x)) <= 64.0 * np.finfo(float).eps * np.maximum(np.abs(x), 1.0)
+    decimal = np.where(whole.any(axis=1), units[np.argmax(whole, axis=1)], 0.0)
+    single = t.astype(np.float32)
+    exact = single.astype(float) == t
+    spacing = np.where(exact, np.spacing(np.abs(single)).astype(float), 0.0)
+    return np.maximum(decimal, spacing)
+
+
+def uniform_to_written_precision(t: np.ndarray) -> bool:
+    """Whether times ``t`` lie on a uniform grid to within the rounding they were written with:
+    each within half its :func:`written_resolution` (and the grid's own fitting error) of the
+    least-squares line through them, and never more than :data:`TIME_ROUNDING_MAX_STEP_SHARE`
+    of a step. The samples are then used as written."""
+    t = np.asarray(t, dtype=float)
+    k = np.arange(t.size, dtype=float)
+    line = np.polyval(np.polyfit(k, t, 1), k)
+    resid = np.abs(t - line)
+    step = (t[-1] - t[0]) / (t.size - 1)
+    half = np.minimum(0.5 * written_resolution(t), TIME_ROUNDING_MAX_STEP_SHARE * step)
+    slack = 3.0 * float(np.sqrt(np.mean(resid ** 2))) / np.sqrt(t.size) + 8.0 * np.finfo(float).eps * float(
+        np.max(np.abs(t)))
+    return bool(np.all(resid <= half + slack))
+
+
 def _check_time(rec: Recording, src: str) -> np.ndarray:
     time_col = CHANNELS["t"].column
     if time_col not in rec.data.columns:
@@ -166,11 +212,12 @@ def _check_time(rec: Recording, src: str) -> np.ndarray:
     mean_step = (t[-1] - t[0]) / (len(t) - 1)
     dev = np.abs(step - mean_step) / mean_step
     worst = int(np.argmax(dev))
-    if dev[worst] > TIME_JITTER_TOL:
+    if dev[worst] > TIME_JITTER_TOL and not uniform_to_written_precision(t):
         raise RecordingError(
             f"time step is not uniform: step {float(step[worst])!r} s between rows {worst + 1} and "
             f"{worst + 2} ({ROW_CONVENTION}; t={float(t[worst])!r}) deviates by {dev[worst]:.3g} (relative) from the "
-            f"mean step {float(mean_step)!r} s; tolerance {TIME_JITTER_TOL:g}",
+            f"mean step {float(mean_step)!r} s; tolerance {TIME_JITTER_TOL:g}, beyond the rounding of the written "
+            "times",
             source=src, key=_col(time_col), rule="time-not-uniform",
         )
     return t

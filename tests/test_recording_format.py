@@ -18,6 +18,7 @@ from maneuvers.recording import (
     MASS_KEYS,
     REQUIRED_QUANTITIES,
     Recording,
+    TIME_JITTER_TOL,
     RecordingError,
     parse_column,
     to_canonical,
@@ -319,6 +320,37 @@ def test_time_jitter_below_tolerance_is_accepted() -> None:
         df["t_s"] = t
 
     with_data(make_recording(), edit).validate(SOURCE)
+
+
+@pytest.mark.parametrize("rate_hz", [60.0, 120.0, 30.0])
+@pytest.mark.parametrize("written", ["%.8g", "%.6f", "float32"])
+def test_times_rounded_as_written_are_uniform(rate_hz: float, written: str, tmp_path) -> None:
+    """A 60, 120 or 30 Hz recording whose times were written to 8 significant digits, six
+    decimals or single precision (16.016667 s) steps unevenly by up to 3e-4 of a step, though
+    it was sampled uniformly: read, through the CSV, with its samples as written."""
+    n = int(200 * rate_hz)  # 200 s: the rounding grows with the time
+    exact = 100.0 + np.arange(n) / rate_hz
+    t = exact.astype(np.float32).astype(float) if written == "float32" else np.array([float(written % v) for v in exact])
+    rec = make_recording(n=n, dt=1.0 / rate_hz)
+    rec.data["t_s"] = t
+    assert np.max(np.abs(np.diff(t) * rate_hz - 1.0)) > TIME_JITTER_TOL
+    from harness.recording_io import read_recording, write_recording
+    write_recording(rec, tmp_path / "r.csv")
+    back = read_recording(tmp_path / "r.csv")
+    assert np.array_equal(back.t, t)
+
+
+def test_times_off_the_grid_by_more_than_their_rounding_are_refused() -> None:
+    """Six-decimal times with one sample 2 µs late (twice its rounding) at 60 Hz, and
+    millisecond times at 60 Hz with one sample a millisecond late (its rounding is half
+    of that): refused, naming a step next to the late sample (data row ``row + 1``)."""
+    for decimals, late, row in ((6, 2e-6, 70), (3, 1e-3, 40)):
+        def edit(df: pd.DataFrame, decimals=decimals, late=late, row=row) -> None:
+            t = np.round(np.arange(len(df)) / 60.0, decimals)
+            t[row] += late
+            df["t_s"] = t
+
+        refused(with_data(make_recording(), edit), "'t_s'", "time-not-uniform", f"{row + 1}")
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
