@@ -66,7 +66,7 @@ def test_lateral_only_maneuver_names_no_pitch_term(tmp_path):
 def test_assumptions_name_the_stand_ins_for_missing_channels(tmp_path):
     rec = fly_maneuver(FlightSpec(input=default_three_axis_input(), condition="h=20000,V=600"))
     data = rec.data.drop(columns=["h_ft", "thrust_lbf"])
-    meta = {k: v for k, v in rec.meta.items() if k not in ("truth", "simulation")}
+    meta = {k: v for k, v in rec.meta.items() if k not in ("truth", "simulation", "thrust_offset_ft")}
     meta["trim"] = {k: v for k, v in meta["trim"].items() if k != "thrust_lbf"}
     path = tmp_path / "bare.csv"
     write_recording(type(rec)(data=data[[c for c in data.columns if not c.startswith("truth_")]], meta=meta,
@@ -78,6 +78,7 @@ def test_assumptions_name_the_stand_ins_for_missing_channels(tmp_path):
     assert abs(float(by_item["altitude"]["stood_in_by"].split("(")[1].split(" ft")[0]) - 20_000) < 50
     assert "model's trim thrust" in by_item["thrust"]["stood_in_by"] and "lbf" in by_item["thrust"]["stood_in_by"]
     assert "surface_levels_deg" in by_item["surface levels (replays)"]["stood_in_by"]
+    assert "through the c.g." in by_item["thrust line"]["stood_in_by"]  # the F-16's is 0.3 ft above it
     assert _effects(result) == ["none"]  # a clean recording of the model, made elsewhere in the envelope
     written = json.loads((tmp_path / "out" / "findings.json").read_text())
     assert written["assumptions"] and written["not_checked"]

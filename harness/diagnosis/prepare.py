@@ -396,6 +396,10 @@ def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...])
                                     "(recording-format: constant at trim)" if trim_thrust is not None else
                                     "constant at the model's trim thrust at the recording's start "
                                     "(recording-format: constant at trim; the metadata give none)")})
+    if "thrust_offset_ft" not in meta:
+        out.append({"item": "thrust line", "missing": "thrust_offset_ft",
+                    "stood_in_by": "through the c.g. (0 ft): a thrust line off it puts thrust × offset / (q̄·S·c̄) "
+                                   "into C_m's mismatch, a constant where thrust is steady"})
     absent = [s for s in SURFACES if s not in raw]
     if absent:
         out.append({"item": "surfaces not recorded", "missing": ", ".join(absent),
