@@ -206,7 +206,8 @@ def _add_diagnose(sub) -> None:
                                    "the significant ones to the model, refine their sizes with JSBSim in the loop "
                                    "(--calibrate) and fly it again. Writes OUT/findings.json, "
                                    "OUT/report.html, OUT/series/*.parquet and OUT/model/ (the augmented aircraft).")
-    g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6), or the path of a "
+    g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6), an aircraft of the jsbsim "
+                                                   "package's library by name (c172x, A320, ...), or the path of a "
                                                    "JSBSim aircraft XML")
     g.add_argument("--mass", choices=("model", "recording"), default="model",
                    help="fly the model with its own mass properties (default) or with the recording's (mass, "
@@ -233,7 +234,8 @@ def _add_calibrate(sub) -> None:
                                      "finite-difference sensitivities from perturbed flights in parallel. Writes "
                                      "OUT/calibration.json, OUT/model/ (the calibrated XML, which flies in stock "
                                      "JSBSim), OUT/series/ and OUT/report.html.")
-    cal.add_argument("--model", required=True, help="aircraft: f16, 737, dhc6, or the path of a JSBSim aircraft XML")
+    cal.add_argument("--model", required=True, help="aircraft: f16, 737, dhc6, an aircraft of the jsbsim package's "
+                     "library by name (c172x, ...), or the path of a JSBSim aircraft XML")
     cal.add_argument("--recording", required=True, action="append",
                      help="identification recording (.csv beside .meta.json, .parquet or SIDPAC .mat); repeatable")
     cal.add_argument("--validation", action="append", default=None,

@@ -10,7 +10,8 @@ INPUT_CHOICES = ("doublet", "2-1-1-2", "2-1-1", "3-2-1-1", "sweep-linear", "swee
                  "three-axis", "lateral")
 
 
-AIRCRAFT_HELP = ("JSBSim model: f16, 737, dhc6, or the path of a JSBSim aircraft XML (flown as it is, nominal "
+AIRCRAFT_HELP = ("JSBSim model: f16, 737, dhc6, an aircraft of the jsbsim package's library by name (c172x, "
+                 "A320, ...), or the path of a JSBSim aircraft XML (flown as it is, nominal "
                  "variant only) (default: f16)")
 CONDITION_HELP = ("flight condition by name (f16: seed-5deg, the default, or alpha-7.5; 737: cruise; dhc6: "
                   "twin-otter-017) or by value, h=<ft>,V=<ft/s true airspeed> (e.g. h=10000,V=427.4; an aircraft "
@@ -51,16 +52,16 @@ def add_noise_options(p: argparse.ArgumentParser) -> None:
 
 def resolve_aircraft(model: str, variant: str = "nominal"):
     """``--aircraft``: a project model by name or a JSBSim aircraft XML by path (as ``diagnose --model``)."""
-    from models.aircraft import MODELS, Aircraft, is_xml_model
+    from models.aircraft import MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument
 
     if model in MODELS:
         try:
             return Aircraft(model, variant)
         except ValueError as exc:
             raise OptionError(f"--aircraft {model}: {exc}") from None
+    given, model = model, model_argument(model)
     if not is_xml_model(model):
-        raise OptionError(f"--aircraft {model!r} is neither one of the project's models {list(MODELS)} "
-                          "nor the path of a JSBSim aircraft XML (<name>.xml)")
+        raise OptionError(f"--aircraft {given!r} is not " + MODEL_ARGUMENT_HELP.format(models=list(MODELS)))
     try:
         aircraft = Aircraft(str(Path(model).resolve()), variant)
         aircraft.surfaces  # noqa: B018 - fails early, naming what the XML lacks

@@ -116,6 +116,33 @@ def is_xml_model(model: str) -> bool:
     return str(model).lower().endswith(".xml")
 
 
+def library_xml(name: str) -> Path | None:
+    """The jsbsim package's aircraft XML for a library name (``c172x``, ``A320``: its
+    ``aircraft/<name>/<name>.xml``, the name matched without regard to case when only one
+    matches), or None. The project's own models are not looked up here."""
+    folder = package_root() / "aircraft"
+    exact = folder / name / f"{name}.xml"
+    if exact.is_file():
+        return exact
+    matches = [p for p in folder.glob("*/*.xml") if p.stem.lower() == str(name).lower()
+               and p.parent.name.lower() == str(name).lower()]
+    return matches[0] if len(matches) == 1 else None
+
+
+def model_argument(model: str) -> str:
+    """A ``--model``/``--aircraft`` argument as the project reads it: a project model name or
+    an XML path unchanged, a name of the jsbsim package's aircraft library (:func:`library_xml`)
+    as the path of its XML, anything else unchanged (the caller refuses it)."""
+    if model in MODELS or is_xml_model(model):
+        return model
+    found = library_xml(model)
+    return str(found) if found is not None else model
+
+
+MODEL_ARGUMENT_HELP = ("one of the project's models {models}, the name of an aircraft in the jsbsim package's "
+                       "library (c172x, A320, …) or the path of a JSBSim aircraft XML (<name>.xml)")
+
+
 def model_xml(model: str) -> Path:
     """The aircraft XML a model is built from: the package's, or the file given by path."""
     if is_xml_model(model):

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from models.aircraft import Aircraft, load_fdm
+from models.aircraft import Aircraft, has_propeller, load_fdm
 from models.conditions import FlightCondition
 from models.flight import FlightHistory, fly
 from models.hidden import hidden_root, needs_copy
@@ -153,7 +153,8 @@ def held_mean(a: np.ndarray, w: float, t: np.ndarray, x: np.ndarray) -> np.ndarr
 class AeroAlong:
     """The model's aerodynamic coefficients along a recording's states.
 
-    ``coefficients[C]`` per sample (C in CX, CY, CZ, Cl, Cm, Cn, about the c.g.);
+    ``coefficients[C]`` per sample (C in CX, CY, CZ, Cl, Cm, Cn, about the c.g.; the moments
+    with the propellers' moments beyond the thrust line, ``propulsion``);
     ``derivatives`` the model's local slopes at the trim point (truth.central_differences
     names, e.g. ``Cm_alpha``, per rad, rates normalised); ``unsteady`` its α̇ derivatives.
     """
@@ -163,6 +164,9 @@ class AeroAlong:
     unsteady: dict[str, float]
     trim: TrimPoint
     trim_failed: str = ""  # why the model could not trim there (derivatives then at the recorded start)
+    # the part of the moment coefficients that is the propellers' beyond the thrust line
+    # (truth.CoefficientProbe.propulsion_moments: gyroscopic and inflow moments), included above
+    propulsion: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np.ndarray],
@@ -174,6 +178,15 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     canonical units; ``surfaces`` absolute positions ``de, da, dr`` (rad). Any α̇ term of the
     model is gated off for the evaluation and added back as its α̇ derivative times the
     recorded ``alphadot`` (rad/s), since ``run_ic`` cannot know the α̇ of a recorded sample.
+
+    A propeller's engine is settled at each state (JSBSim's ``FGPropulsion::GetSteadyState``,
+    the throttle as trimmed) before the forces are read: ``run_ic`` keeps the propeller turning
+    at the trim's rpm, and an aerodynamic term that reads the propeller (the DHC6's slipstream
+    moment CmT reads its thrust coefficient) then follows a propeller the aircraft never flew.
+    The DHC6 trimmed at 230 ft/s and evaluated at 375 ft/s so windmills at 1,431 rpm (thrust
+    coefficient 0.005 where its flight, at 1,883 rpm, had 0.052; C_m 0.008 apart), settled at
+    1,894 rpm and 0.055; a spiral dive from 230 to 367 ft/s then put a C_m mismatch of 0.025
+    into a noise-free flight of the model itself, read as C_m,ΔV (t 12-19).
     """
     cond, kwargs = _instance(aircraft, ic, refs)
     trim_failed = ""
@@ -198,6 +211,8 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
                ("ic/h-sl-ft", "ic/vt-fps", "ic/alpha-rad", "ic/beta-rad", "ic/theta-rad", "ic/phi-rad",
                 "ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", surf["de"], surf["da"], surf["dr"])}
     out = {c: np.empty(n) for c in BODY_COEFFICIENTS}
+    propulsion = {c: np.empty(n) for c in ("Cl", "Cm", "Cn")}
+    engines = fdm.get_propulsion() if has_propeller(aircraft.model) else None
     fdm["ic/lat-gc-deg"] = 0.0
     fdm["ic/long-gc-deg"] = 0.0
     for k in range(n):
@@ -213,9 +228,16 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
         for s in SURFACES:
             setters[surf[s]](float(sv[s][k]))
         fdm.run_ic()
+        if engines is not None:  # the propeller settled at this state (docstring), then the forces again
+            engines.get_steady_state()
+            fdm.run_ic()
         row = probe.read()
         for c in out:
             out[c][k] = row[c]
+        for c, v in probe.propulsion_moments().items():
+            propulsion[c][k] = v
+    for c, v in propulsion.items():  # the model's moments are its airframe's and its propellers'
+        out[c] = out[c] + v
     if unsteady and alphadot is not None:
         adot_hat = np.asarray(alphadot, dtype=float) * tp.cbar_ft / (2.0 * cols["V"])
         for c in ("CX", "CZ", "Cm"):
@@ -224,7 +246,8 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     if bad:
         raise ValueError(f"the model's aerodynamics are not finite along the recording ({', '.join(bad)}); "
                          "the recorded states leave the model's tables")
-    return AeroAlong(coefficients=out, derivatives=derivatives, unsteady=unsteady, trim=tp, trim_failed=trim_failed)
+    return AeroAlong(coefficients=out, derivatives=derivatives, unsteady=unsteady, trim=tp, trim_failed=trim_failed,
+                     propulsion=propulsion)
 
 
 def initial_condition(t: np.ndarray, V: np.ndarray, alpha: np.ndarray, h: np.ndarray | None,

@@ -167,6 +167,20 @@ class CoefficientProbe:
                 "Cm": M / (qS * tp.cbar_ft), "Cn": N / (qS * tp.b_ft),
                 **{k: float(v) for k, v in wind_axis_coefficients(CX, CZ, a).items()}}
 
+    def propulsion_moments(self) -> dict[str, float]:
+        """The propulsion's moment coefficients at the last ``run_ic``'s state beyond thrust
+        times the trim's thrust line (the part seed Eq. 4 takes out of the measured C_m with the
+        recorded thrust): a propeller's gyroscopic moments (its spin times the body rates: a
+        yaw rate pitches, a pitch rate yaws) and the change of each propeller's inflow with the
+        rates. The DHC6's two propellers (25.1 slug·ft² each, aircraft/DHC6/Engines/Propeller.xml)
+        at 1,431 rpm give −752 lbf·ft of pitching moment at r = 0.1 rad/s, a C_m of −0.005 at
+        230 ft/s and 6,000 ft. Zero for a jet, whose propulsion moment is its thrust line's."""
+        fdm, tp = self.fdm, self.tp
+        qS = fdm["aero/qbar-psf"] * tp.S_ft2
+        beyond_line = fdm["moments/m-prop-lbsft"] - fdm["forces/fbx-prop-lbs"] * tp.thrust_offset_ft
+        return {"Cl": fdm["moments/l-prop-lbsft"] / (qS * tp.b_ft), "Cm": beyond_line / (qS * tp.cbar_ft),
+                "Cn": fdm["moments/n-prop-lbsft"] / (qS * tp.b_ft)}
+
     def unsteady_derivatives(self) -> dict[str, float]:
         """α̇ derivatives (α̇ normalised by c̄/2V): the coefficient change when the gated α̇
         terms are switched on at a state with a known α̇, divided by that α̇."""

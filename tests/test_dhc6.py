@@ -137,3 +137,53 @@ def test_condition_is_the_twin_otter_record_017_mean():
     assert cond.h_ft == pytest.approx(rec.channel("h").mean(), abs=5)
     mean = {k: float(np.mean(v)) for k, v in rec.mass_at().items()}
     assert MassProperties.from_mapping(mean) == RECORD_017
+
+
+def test_the_model_along_a_dive_follows_the_propeller_the_flight_had():
+    """The DHC6 flown into a spiral dive (all three surfaces at once, 230 to 370 ft/s):
+    evaluated along the flown states (and α̇), the model's aerodynamic C_m is JSBSim's own in
+    flight to 0.001. ``run_ic`` alone kept the propeller at its trim rpm, windmilling at the dive's
+    speed, and its slipstream moment (CmT) 0.025 off (models.replay.aero_along). The
+    propeller moments beyond the thrust line (gyroscopic) are reported apart."""
+    from maneuvers.combine import Sequence, Simultaneous
+    from maneuvers.fly import FlightSpec, fly_maneuver
+    from maneuvers.multistep import multistep
+    from models.replay import InitialCondition, aero_along
+    parts = (multistep("3-2-1-1", "de", 2.0, 0.5), multistep("doublet", "da", 2.0, 1.0),
+             multistep("2-1-1", "dr", 2.0, 1.0))
+    rec = fly_maneuver(FlightSpec(input=Sequence((Simultaneous(parts),), gap_s=2.0), aircraft=Aircraft("dhc6"),
+                                  condition="h=6000,V=230", duration_s=30.0, sample_rate_hz=10.0))
+    d = rec.data
+    assert d["V_fps"].max() > 360.0
+    states = {k: d[f"{k}_{u}"].to_numpy() for k, u in (("V", "fps"), ("alpha", "rad"), ("beta", "rad"), ("p", "rps"),
+                                                      ("q", "rps"), ("r", "rps"), ("phi", "rad"), ("theta", "rad"),
+                                                      ("h", "ft"))}
+    surfaces = {s: d[f"{s}_rad"].to_numpy() for s in ("de", "da", "dr")}
+    along = aero_along(Aircraft("dhc6"), InitialCondition(6000.0, 230.0), states, surfaces,
+                       d["truth_alphadot_rps"].to_numpy())
+    aero_cm = along.coefficients["Cm"] - along.propulsion["Cm"]
+    assert np.max(np.abs(aero_cm - d["truth_Cm_1"].to_numpy())) < 0.001  # 6e-4; 0.027 unsettled
+    assert np.max(np.abs(along.propulsion["Cm"])) > 0.002  # a yaw rate of 0.08 rad/s pitches the propellers
+
+
+def test_propeller_gyroscopic_moment_is_the_spin_times_the_yaw_rate():
+    """models.truth.CoefficientProbe.propulsion_moments: a yaw rate r pitches the DHC6 by its
+    two propellers' angular momentum, 2·I·Ω·r (I = 25.1034 slug·ft², Propeller.xml; Ω its
+    rpm), beyond the thrust line; nothing beyond it at trim; nothing for a jet."""
+    from models.replay import InitialCondition, _instance
+    from models.truth import CoefficientProbe, differencing_instance
+    for model, ic in (("dhc6", InitialCondition(6000.0, 230.0)), ("f16", InitialCondition(10000.0, 420.0))):
+        ac = Aircraft(model)
+        cond, kwargs = _instance(ac, ic, None)
+        fdm, tp, gated = differencing_instance(ac, cond, **kwargs)
+        probe = CoefficientProbe(fdm, ac, tp, gated)
+        probe.evaluate()
+        assert probe.propulsion_moments()["Cm"] == pytest.approx(0.0, abs=1e-12)
+        probe.evaluate(rhat=0.1 * tp.b_ft / (2 * tp.V_fps))
+        qSc = fdm["aero/qbar-psf"] * tp.S_ft2 * tp.cbar_ft
+        pitch = probe.propulsion_moments()["Cm"] * qSc
+        if model == "f16":
+            assert pitch == 0.0
+            continue
+        spin = fdm["propulsion/engine[0]/propeller-rpm"] * 2 * math.pi / 60
+        assert abs(pitch) == pytest.approx(2 * 25.1034 * spin * 0.1, rel=1e-3)

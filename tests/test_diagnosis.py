@@ -93,8 +93,21 @@ def test_augmented_model_is_written(gallery):
 
 
 def test_unknown_model_is_refused(tmp_path):
-    with pytest.raises(DiagnosisError, match="neither one of the project's models"):
+    with pytest.raises(DiagnosisError, match="'gremlin' is not one of the project's models.*package's library"):
         diagnose("gremlin", tmp_path / "x.csv", tmp_path / "out")
+
+
+def test_a_model_named_from_the_jsbsim_library_is_its_xml():
+    """``--model c172x`` (or ``C172X``): the jsbsim package's aircraft/c172x/c172x.xml, as if
+    given by path; the project's names and paths pass unchanged, an unknown name too (to be
+    refused by the caller)."""
+    from models.aircraft import library_xml, model_argument
+    from models.jsbsim_root import package_root
+    xml = package_root() / "aircraft" / "c172x" / "c172x.xml"
+    assert model_argument("c172x") == model_argument("C172X") == str(xml)
+    assert library_xml("a320") == package_root() / "aircraft" / "A320" / "A320.xml"
+    assert [model_argument(m) for m in ("f16", "737", "dhc6", "x/jet.xml", "gremlin")] == \
+        ["f16", "737", "dhc6", "x/jet.xml", "gremlin"]
 
 
 def test_model_given_as_a_jsbsim_xml_path_diagnoses_like_the_named_model(gallery, tmp_path):

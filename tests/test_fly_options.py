@@ -46,7 +46,10 @@ def test_fly_and_truth_take_dhc6_and_an_xml_path(tmp_path, capsys):
     assert main(["truth", "--aircraft", "dhc6"]) == 0
     assert "dhc6 at twin-otter-017" in capsys.readouterr().out
     assert main(["truth", "--aircraft", str(xml), "--condition", "h=4000,V=180"]) == 0
-    assert "Cm_alpha" in capsys.readouterr().out
+    by_path = capsys.readouterr().out
+    assert "Cm_alpha" in by_path
+    assert main(["truth", "--aircraft", "c172x", "--condition", "h=4000,V=180"]) == 0  # by its library name
+    assert capsys.readouterr().out == by_path
     assert main(["fly", "--aircraft", "nope", "--out", str(tmp_path / "x.csv")]) == 2
     assert "--aircraft 'nope'" in capsys.readouterr().err
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from harness.errors import UserError
 from harness.isa import density_altitude_ft
-from models.aircraft import MODELS, Aircraft, is_xml_model, model_xml, nominal_tree
+from models.aircraft import MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument, model_xml, nominal_tree
 from models.calibration_xml import Adjustment, adjusted_tree, check_adjustments, delays
 from models.constants import SURFACES
 from models.flight import FlightError
@@ -60,8 +60,9 @@ def base_aircraft(model: str, mass: MassProperties | None = None) -> Base:
     CalibrationError
         For an unknown model or an unreadable XML.
     """
+    given, model = model, model_argument(model)
     if model not in MODELS and not is_xml_model(model):
-        raise CalibrationError(f"--model {model!r} is neither one of {MODELS} nor the path of a JSBSim aircraft XML")
+        raise CalibrationError(f"--model {given!r} is not " + MODEL_ARGUMENT_HELP.format(models=MODELS))
     try:
         aircraft = Aircraft(str(Path(model).resolve()) if is_xml_model(model) else model)
         aircraft.surfaces  # noqa: B018 - names a surface the XML lacks

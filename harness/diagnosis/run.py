@@ -22,7 +22,7 @@ from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_
                                        not_checked, remaining_mismatch)
 from harness.executors import LocalPool
 from harness.recording_io import read_recording
-from models.aircraft import Aircraft, MODELS, is_xml_model, nominal_root
+from models.aircraft import MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument, nominal_root
 from models.mass import MassProperties, mass_root
 from models.replay import initial_condition
 
@@ -36,9 +36,9 @@ def _aircraft(model: str) -> Aircraft:
     """A project model by name, or a JSBSim aircraft XML by path (flown as it is)."""
     if model in MODELS:
         return Aircraft(model)
+    given, model = model, model_argument(model)
     if not is_xml_model(model):
-        raise DiagnosisError(f"--model {model!r} is neither one of the project's models {MODELS} "
-                             "nor the path of a JSBSim aircraft XML (<name>.xml)")
+        raise DiagnosisError(f"--model {given!r} is not " + MODEL_ARGUMENT_HELP.format(models=MODELS))
     try:
         aircraft = Aircraft(str(Path(model).resolve()))
         aircraft.surfaces  # noqa: B018 - fails early, naming a surface the XML lacks
