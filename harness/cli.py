@@ -206,9 +206,9 @@ def _add_diagnose(sub) -> None:
                                    "the significant ones to the model, refine their sizes with JSBSim in the loop "
                                    "(--calibrate) and fly it again. Writes OUT/findings.json, "
                                    "OUT/report.html, OUT/series/*.parquet and OUT/model/ (the augmented aircraft).")
-    g.add_argument("--model", required=True, help="aircraft model in models/ (f16, 737, dhc6), an aircraft of the jsbsim "
-                                                   "package's library by name (c172x, A320, ...), or the path of a "
-                                                   "JSBSim aircraft XML")
+    g.add_argument("--model", required=True,
+                   help="aircraft model in models/ (f16, 737, dhc6), an aircraft of the jsbsim package's library by "
+                        "name (c172x, A320, ...), or the path of a JSBSim aircraft XML")
     g.add_argument("--mass", choices=("model", "recording"), default="model",
                    help="fly the model with its own mass properties (default) or with the recording's (mass, "
                         "inertia at its first sample)")

@@ -389,16 +389,25 @@ def test_a_c172x_alpha_vane_bias_is_named_from_the_longitudinal_coefficient_mean
     assert f["evidence"]["validation"]["status"] == "confirmed"
 
 
-def test_a_c172x_moment_drift_is_named_once_the_vane_noise_leaves_cm(tmp_path):
+def test_a_c172x_moment_drift_is_found_once_the_vane_noise_leaves_cm(tmp_path):
     """Outside case C1_three_axis (C_m ΔV/V 0.02, c172x at 180 ft/s): the α vane's wander,
     passed through the model's C_m,α, was a third of C_m's mismatch and hid the drift; with
-    the vane-noise column in C_m's fit (stepwise_axes.vane_noise_columns) it is named, its size
-    within 25 %, nothing else named."""
+    the vane-noise column in C_m's fit (stepwise_axes.vane_noise_columns) the identification
+    enters it, far above the entry t, and nothing else is named. Its validation maneuver
+    hardly changes speed: with the propellers' gyroscopic moments in the model
+    (models.replay.aero_along) the drift's prediction improves that maneuver's C_m by 0.3 %,
+    short of the 1 % that confirms, and it is reported apart as neutral, not contradicted
+    (before, 1.9 %: part of that was the gyroscopic moment the drift imitated)."""
     from harness.diagnosis.outside import run_case
     from harness.diagnosis.outside_cases import cases
     c = next(c for c in cases() if c.name == "C1_three_axis_flight_condition_drift_Cm_dV_0.02")
     row = run_case(c, tmp_path)
-    assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, row["first"]
+    assert row["error"] is None and row["c"] == 0, row["first"]
+    result = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
+    drift = next(x for x in result["candidates"] if x["parameter"] == "Cm_dV")
+    assert drift["selected"] and drift["t"] > 10.0
+    kept = [f for f in result["findings"] + result["not_confirmed"] if f["parameter"] == "Cm_dV"]
+    assert kept and (kept[0] in result["findings"] or kept[0]["evidence"]["validation"]["status"] == "neutral")
 
 
 def test_a_c172x_moment_reference_shift_is_sized_by_the_mistrim_of_cm(tmp_path):

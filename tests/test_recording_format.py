@@ -330,7 +330,10 @@ def test_times_rounded_as_written_are_uniform(rate_hz: float, written: str, tmp_
     it was sampled uniformly: read, through the CSV, with its samples as written."""
     n = int(200 * rate_hz)  # 200 s: the rounding grows with the time
     exact = 100.0 + np.arange(n) / rate_hz
-    t = exact.astype(np.float32).astype(float) if written == "float32" else np.array([float(written % v) for v in exact])
+    if written == "float32":
+        t = exact.astype(np.float32).astype(float)
+    else:
+        t = np.array([float(written % v) for v in exact])
     rec = make_recording(n=n, dt=1.0 / rate_hz)
     rec.data["t_s"] = t
     assert np.max(np.abs(np.diff(t) * rate_hz - 1.0)) > TIME_JITTER_TOL
