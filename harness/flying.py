@@ -54,12 +54,12 @@ def resolve_aircraft(model: str, variant: str = "nominal"):
     """``--aircraft``: a project model by name or a JSBSim aircraft XML by path (as ``diagnose --model``)."""
     from models.aircraft import MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument
 
+    given, model = model, model_argument(model)
     if model in MODELS:
         try:
             return Aircraft(model, variant)
         except ValueError as exc:
-            raise OptionError(f"--aircraft {model}: {exc}") from None
-    given, model = model, model_argument(model)
+            raise OptionError(f"--aircraft {given}: {exc}") from None
     if not is_xml_model(model):
         raise OptionError(f"--aircraft {given!r} is not " + MODEL_ARGUMENT_HELP.format(models=list(MODELS)))
     try:

@@ -130,11 +130,15 @@ def library_xml(name: str) -> Path | None:
 
 
 def model_argument(model: str) -> str:
-    """A ``--model``/``--aircraft`` argument as the project reads it: a project model name or
-    an XML path unchanged, a name of the jsbsim package's aircraft library (:func:`library_xml`)
-    as the path of its XML, anything else unchanged (the caller refuses it)."""
-    if model in MODELS or is_xml_model(model):
+    """A ``--model``/``--aircraft`` argument as the project reads it: a project model name in
+    any case (``F16``, ``DHC6``: the project's model, configured as it flies, not the package's
+    file) or an XML path as given, a name of the jsbsim package's aircraft library
+    (:func:`library_xml`) as the path of its XML, anything else unchanged (the caller refuses
+    it)."""
+    if is_xml_model(model):
         return model
+    if str(model).lower() in MODELS:
+        return str(model).lower()
     found = library_xml(model)
     return str(found) if found is not None else model
 

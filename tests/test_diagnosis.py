@@ -99,8 +99,8 @@ def test_unknown_model_is_refused(tmp_path):
 
 def test_a_model_named_from_the_jsbsim_library_is_its_xml():
     """``--model c172x`` (or ``C172X``): the jsbsim package's aircraft/c172x/c172x.xml, as if
-    given by path; the project's names and paths pass unchanged, an unknown name too (to be
-    refused by the caller)."""
+    given by path; the project's names (in any case) and paths pass as the project's, an unknown
+    name unchanged (to be refused by the caller)."""
     from models.aircraft import library_xml, model_argument
     from models.jsbsim_root import package_root
     xml = package_root() / "aircraft" / "c172x" / "c172x.xml"
@@ -108,6 +108,8 @@ def test_a_model_named_from_the_jsbsim_library_is_its_xml():
     assert library_xml("a320") == package_root() / "aircraft" / "A320" / "A320.xml"
     assert [model_argument(m) for m in ("f16", "737", "dhc6", "x/jet.xml", "gremlin")] == \
         ["f16", "737", "dhc6", "x/jet.xml", "gremlin"]
+    # the project's own models in any case: configured as they fly, not the package's files
+    assert [model_argument(m) for m in ("F16", "DHC6", "Dhc6")] == ["f16", "dhc6", "dhc6"]
 
 
 def test_model_given_as_a_jsbsim_xml_path_diagnoses_like_the_named_model(gallery, tmp_path):

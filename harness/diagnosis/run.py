@@ -34,9 +34,9 @@ UNEXPLAINED_RATIO = 5.0
 
 def _aircraft(model: str) -> Aircraft:
     """A project model by name, or a JSBSim aircraft XML by path (flown as it is)."""
+    given, model = model, model_argument(model)
     if model in MODELS:
         return Aircraft(model)
-    given, model = model, model_argument(model)
     if not is_xml_model(model):
         raise DiagnosisError(f"--model {given!r} is not " + MODEL_ARGUMENT_HELP.format(models=MODELS))
     try:
