@@ -1274,3 +1274,34 @@ def test_a_heading_recorded_wrapped_is_read_as_the_continuous_angle(tmp_path):
     assert wrapped.noise_std["psi"] == pytest.approx(continuous.noise_std["psi"], rel=1e-9)
     shift = wrapped.smooth["psi"] - continuous.smooth["psi"]
     assert np.allclose(shift, 2.0 * np.pi * round(shift[0] / (2.0 * np.pi)), rtol=0, atol=1e-9)
+
+
+def test_an_error_of_a_vane_the_maneuver_did_not_drive_says_nothing_of_plausibility():
+    """sensor_rules.kinematics_plausible with the recording: on a pitch maneuver (β, p, r not
+    driven) a β-vane bias of 18° at t 3 (it shows only through the airspeed's changes) no
+    longer makes the kinematics implausible; the same estimate on a maneuver that drove β
+    does, and so does an implausible gyro bias on the pitch maneuver (a rate bias shows in
+    the Euler-angle equations whatever the maneuver). The implausible estimate is never
+    applied."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.sensor_rules import kinematics_plausible, undriven_vane
+
+    def kin(params):
+        sel = SimpleNamespace(params=params, std_errors={k: abs(v) / 3.04 for k, v in params.items()}, names=())
+        return SimpleNamespace(selection=sel, forced=tuple(params))
+
+    pitch = SimpleNamespace(driven=("alpha", "q", "V", "de"))
+    lateral = SimpleNamespace(driven=("beta", "p", "r", "da", "dr"))
+    assert undriven_vane("bias_beta", pitch) and undriven_vane("vane_beta_x", pitch)
+    assert not undriven_vane("bias_alpha", pitch) and not undriven_vane("bias_q", pitch)
+    assert undriven_vane("scale_alpha", lateral) and not undriven_vane("bias_beta", lateral)
+    beta = kin({"bias_alpha": 0.0135, "bias_beta": 0.315})
+    assert not kinematics_plausible(beta, 427.4)
+    assert kinematics_plausible(beta, 427.4, pitch)
+    assert not kinematics_plausible(beta, 427.4, lateral)
+    assert not kinematics_plausible(kin({"bias_q": 0.3}), 427.4, pitch)
+    # and the implausible estimate itself is never applied to the channels (an 18° β bias took
+    # a 737 pitch null's states off the model's tables)
+    from harness.diagnosis.sensor_rules import applied_sensor_values
+    assert applied_sensor_values(beta, False, True, 427.4) == {"bias_alpha": 0.0135}

@@ -49,9 +49,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     near = "" if turbulent or gusty else light_gusts(gust, p, V0, LIGHT_TURBULENCE_FACTOR)
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)
-    plausible = kinematics_plausible(kin, V0)
+    plausible = kinematics_plausible(kin, V0, p)
     contested = contested_parameters(kin)
-    sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible).items()
+    sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
                      if n not in contested}
     recorded, p = p, corrected_recording(p, kin, sensor_values)
     # 2. the model along the measured states

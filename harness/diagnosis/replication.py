@@ -130,7 +130,7 @@ def _kinematics_trusted(a: Analysis) -> bool:
     named, no light gusts (:func:`light_gusts`), every supported estimate plausible."""
     turbulent = any(c.effect == "turbulence" and c.selected for c in a.candidates)
     V0 = float(np.mean(a.prepared.smooth["V"]))
-    return not turbulent and not a.gusty and kinematics_plausible(a.kinematic, V0)
+    return not turbulent and not a.gusty and kinematics_plausible(a.kinematic, V0, a.prepared)
 
 
 def name_mode_on_both(a: Analysis, av: Analysis) -> Candidate | None:

@@ -21,23 +21,42 @@ from models.aircraft import Aircraft
 from models.replay import InitialCondition
 
 
-def kinematics_plausible(kin: KinematicResult, V0: float) -> bool:
+def kinematics_plausible(kin: KinematicResult, V0: float, p: Prepared | None = None) -> bool:
     """Whether every kinematic estimate the data support (|t| >= :data:`APPLY_T`) is one an
     instrument could have; an unsupported one (a lateral bias on a pitch maneuver) says
-    nothing about plausibility."""
+    nothing about plausibility, and neither does an error of a vane whose angle the maneuver
+    did not drive (:func:`undriven_vane`, given the recording ``p``)."""
     return all(is_plausible(n, kin.selection.params[n], V0) or kinematic_t(kin, n) < APPLY_T
+               or (p is not None and undriven_vane(n, p))
                for n in kin.forced + kin.selection.names)
 
 
-def applied_sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool) -> dict[str, float]:
+def undriven_vane(name: str, p: Prepared) -> bool:
+    """Whether kinematic parameter ``name`` is an error of the α or β vane (bias, scale, skew,
+    position) on a recording whose surfaces never drove that angle (``p.driven``). The vane's
+    angle enters the kinematics through u = V cos α cos β, v = V sin β, w = V sin α cos β, so
+    a constant error of a still angle shows only through the airspeed's changes (V̇·b in v̇
+    for β): a Wald t there measures nothing an instrument did. On pitch maneuvers that made
+    a β bias of −25° (t 3.3, a T-6) and 18° (t 3.0, the F-16 at 427 ft/s) "implausible", which
+    voided every sensor test of the maneuver (the α bias of probe 21 was set apart as not
+    confirmed: its validation maneuver's means test never ran)."""
+    vane = next((v for v in ("alpha", "beta") if name.endswith(f"_{v}") or name.startswith(f"vane_{v}_")), None)
+    return vane is not None and vane not in p.driven
+
+
+def applied_sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool,
+                          V0: float | None = None) -> dict[str, float]:
     """The sensor corrections applied before the model is evaluated. None in turbulence or
     when an estimate is implausible (the kinematics then disagree for another reason, and
     the parameters were estimated together); else only those with |t| >= :data:`APPLY_T` (a
     nuisance bias "below the entry t" may be a poorly determined 0.7 deg, and applying it
-    would move the model)."""
+    would move the model), and, given the airspeed ``V0``, never an implausible one (an
+    undriven vane's, which :func:`kinematics_plausible` leaves out of its verdict: an 18° β
+    bias applied to a 737 pitch maneuver took the states off the model's tables)."""
     if turbulent or not plausible:
         return {}
-    return {n: kin.selection.params[n] for n in kin.forced + kin.selection.names if kinematic_t(kin, n) >= APPLY_T}
+    return {n: kin.selection.params[n] for n in kin.forced + kin.selection.names
+            if kinematic_t(kin, n) >= APPLY_T and (V0 is None or is_plausible(n, kin.selection.params[n], V0))}
 
 
 def sensor_verdict(name: str, est: float, se: float, entered: bool, kin: KinematicResult, p: Prepared,
@@ -47,6 +66,8 @@ def sensor_verdict(name: str, est: float, se: float, entered: bool, kin: Kinemat
     kinematics must hold (no turbulence, no gusts that break them, plausible estimates)."""
     practical = is_practical(name, est, p.dt) and kinematic_share(kin, name, est, p) >= cand.PRACTICAL_SHARE
     precise = se <= max(0.5 * practical_size(name, p.dt), 0.25 * abs(est))
+    # the estimate itself too (an undriven vane's is left out of the kinematics' verdict)
+    plausible = plausible and is_plausible(name, est, float(np.mean(p.smooth["V"])))
     sel = entered and practical and precise and not turbulent and not gusty and plausible
     reason = ("significant, practical and precise" if sel else "below the entry t" if not entered else
               "within the instrument noise budget (practical size)" if not practical else
