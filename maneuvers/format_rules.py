@@ -151,10 +151,15 @@ def written_resolution(t: np.ndarray) -> np.ndarray:
     16.5, shows 0.1 though it was written to 1e-6; its deviation from the grid is then
     small anyway)."""
     t = np.asarray(t, dtype=float)
-    units = 10.0 ** -np.arange(0, _FINEST_DECIMAL + 1, dtype=float)
-    x = t[:, None] / units[None, :]
-    whole = np.abs(x - np.rint(x)) <= 64.0 * np.finfo(float).eps * np.maximum(np.abs(x), 1.0)
-    decimal = np.where(whole.any(axis=1), units[np.argmax(whole, axis=1)], 0.0)
+    decimal = np.zeros(t.size)
+    pending = np.arange(t.size)  # one unit at a time, coarsest first: memory of the record, not 13 times it
+    for unit in 10.0 ** -np.arange(0, _FINEST_DECIMAL + 1, dtype=float):
+        x = t[pending] / unit
+        whole = np.abs(x - np.rint(x)) <= 64.0 * np.finfo(float).eps * np.maximum(np.abs(x), 1.0)
+        decimal[pending[whole]] = unit
+        pending = pending[~whole]
+        if not pending.size:
+            break
     single = t.astype(np.float32)
     exact = single.astype(float) == t
     spacing = np.where(exact, np.spacing(np.abs(single)).astype(float), 0.0)
