@@ -122,7 +122,9 @@ def _none_line(findings: Sequence[Mapping]) -> str:
     """The plain sentence for a diagnosis that found nothing."""
     none = next((f for f in findings if f.get("effect") == "none"), {})
     why = f" {none['explanation']}" if none.get("explanation") else ""
-    return "No effect found: the model as given explains the recording to within its noise." + why
+    return ("No effect found: the model as given explains the recording to within its noise." + why +
+            " Effects smaller than the detection limits (section 'Assumptions and what was not checked') are not "
+            "ruled out.")
 
 def summary_lines(data: Mapping) -> list[str]:
     """The at-a-glance verdict: each finding (or 'nothing found') and where the mismatch is."""
@@ -139,7 +141,8 @@ def scope_section(data: Mapping) -> Section | None:
     ``assumptions`` and ``not_checked``), shown right after the verdict."""
     assumed = [a for a in data.get("assumptions") or [] if isinstance(a, Mapping)]
     unchecked = [n for n in data.get("not_checked") or [] if isinstance(n, Mapping)]
-    if not assumed and not unchecked:
+    limits = [r for r in data.get("detection_limits") or [] if isinstance(r, Mapping)]
+    if not assumed and not unchecked and not limits:
         return None
     tables = []
     if assumed:
@@ -151,9 +154,31 @@ def scope_section(data: Mapping) -> Section | None:
             [{"effect": n.get("effect", ""), "parameters": ", ".join(map(str, n.get("parameters") or [])) or "—",
               "why": n.get("reason", "")} for n in unchecked]),
             "Effects (or their parameters) this recording cannot test: 'none' does not rule them out."))
+    if limits:
+        tables.append(limits_table(limits))
     return Section("Assumptions and what was not checked",
                    ("The verdict holds under these assumptions and only for what the maneuver could show.",),
                    tuple(tables))
+
+def limits_table(limits: list[Mapping]) -> Table:
+    """findings.json's ``detection_limits`` as a table: per tested, unnamed parameter the
+    smallest estimate (a coefficient error's change from the model) its entry tests name."""
+    def pct(r: Mapping) -> str:
+        rel = r.get("relative_to_model")
+        return f"{100 * rel:.0f} %" if isinstance(rel, (int, float)) and math.isfinite(rel) else "—"
+    rows = [{"parameter": r.get("parameter", ""), "units": r.get("units", ""),
+             "smallest named": f"{r.get('limit', float('nan')):.3g}",
+             "standard error": f"{r.get('std_error', float('nan')):.3g}",
+             "of the model's value": pct(r), "set by": r.get("rule", ""),
+             "estimate": f"{r.get('estimate', float('nan')):.3g}",
+             "withheld (estimate above the limit)": r.get("withheld", "")} for r in limits]
+    return Table("Detection limits", pd.DataFrame(rows),
+                 "Tested parameters not named, and the size their estimate (a coefficient's change from the "
+                 "model) must reach to be named: the entry t times the standard error, the practical share of "
+                 "the coefficient's excursion or the smallest sensor error worth naming, whichever is largest. "
+                 "An effect at the limit is estimated above it about half the time. Other rules (rivals, the validation maneuver) "
+                 "may still withhold a larger effect: a 'none' rules out only what lies above these.")
+
 
 def verdict_section(data: Mapping) -> Section:
     """Section 1: the findings, or a plain 'nothing found' with its evidence."""

@@ -184,3 +184,23 @@ def test_affected_channels_follow_the_findings():
               "located": {"worst_axis": "Cn"}}
     assert affected_channels(offset, None) == ["beta"] and affected_coefficients(offset) == ["Cn"]
     assert affected_channels({"findings": [NONE], "located": _located(False)}, None)[0] == "q"
+
+
+def test_none_report_shows_the_detection_limits(tmp_path):
+    """findings.json's detection_limits become a table beside what was not checked, in
+    percent of the model's value where there is one, and the 'none' sentence points to it."""
+    out = _write_dir(tmp_path, "none", validation=False)
+    data = json.loads((out / "findings.json").read_text())
+    data["detection_limits"] = [
+        {"effect": "coefficient_error", "parameter": "Cm_qhat", "units": "per rad", "limit": 0.584,
+         "std_error": 0.117, "rule": "significance", "floors": {"significance": 0.584}, "model_value": -5.57,
+         "relative_to_model": 0.105},
+        {"effect": "sensor_bias", "parameter": "bias_q", "units": "rad/s", "limit": 0.00262, "std_error": 0.0002,
+         "rule": "practical size", "floors": {"practical size": 0.00262}}]
+    (out / "findings.json").write_text(json.dumps(data))
+    report = diagnosis_report(out)
+    assert "detection limits" in report.summary[0]
+    table = next(t for s in report.sections for t in s.tables if t.title == "Detection limits")
+    rows = table.frame.to_dict("records")
+    assert rows[0]["parameter"] == "Cm_qhat" and rows[0]["of the model's value"] == "10 %"
+    assert rows[1]["of the model's value"] == "—" and rows[1]["set by"] == "practical size"

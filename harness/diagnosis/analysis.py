@@ -112,4 +112,5 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         next(c for c in cands if c.effect == "turbulence").details["process_noise_model"] = process_noise_model(p)
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,
                     selections=step.selections, kinematic=kin, delay=delays, offset=off, gust=gust, peak=peak,
-                    not_offered=step.not_offered, applied=dict(sensor_values), gusty=gusty, air=air)
+                    not_offered=step.not_offered, applied=dict(sensor_values), gusty=gusty, air=air,
+                    nuisances=step.nuisances)

@@ -56,3 +56,4 @@ class Analysis:
     applied: dict = field(default_factory=dict)      # sensor corrections applied before the model was evaluated
     gusty: str = ""  # why light gusts leave the kinematic (sensor) tests untrustworthy ('' when they do not)
     air: AirShare | None = None  # the air-share test, when the kinematics showed gusts
+    nuisances: dict = field(default_factory=dict)  # per axis: the columns always in its stepwise fit

@@ -345,16 +345,22 @@ def channel_share(sp: SensorParameter, value: float, clean: dict[str, np.ndarray
     return max(shares, default=0.0)
 
 
-def is_practical(name: str, value: float, dt: float) -> bool:
-    """Whether a sensor parameter is large enough to name (:data:`PRACTICAL`)."""
+def practical_floor(name: str, dt: float) -> float:
+    """The smallest size of sensor parameter ``name`` worth naming (:data:`PRACTICAL`), in
+    its own units, at sample interval ``dt``."""
     kind, _, channel = name.partition("_")
     if kind == "bias":
-        return abs(value) >= PRACTICAL["bias"].get(channel, 0.0)
+        return PRACTICAL["bias"].get(channel, 0.0)
     if kind == "scale":
-        return abs(value) >= PRACTICAL["scale"]
+        return PRACTICAL["scale"]
     if kind == "skew":
-        return abs(value) >= PRACTICAL["skew_samples"] * dt
-    return abs(value) >= PRACTICAL["offset_ft"]
+        return PRACTICAL["skew_samples"] * dt
+    return PRACTICAL["offset_ft"]
+
+
+def is_practical(name: str, value: float, dt: float) -> bool:
+    """Whether a sensor parameter is large enough to name (:func:`practical_floor`)."""
+    return abs(value) >= practical_floor(name, dt)
 
 
 def corrected_channels(raw: dict[str, np.ndarray], p: Prepared, params: dict[str, SensorParameter],

@@ -14,6 +14,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
                                          sensor_models, terms_of, unsupported_in_the_loop, with_calibration,
                                          write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.prepare import instruments_at_cg, prepare
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
 from harness.diagnosis.validation import undecided, validation_check
@@ -250,6 +251,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         "calibration": calibration,
         "assumptions": assumptions(a, aircraft, mass) + calibration_assumptions(calibration),
         "not_checked": not_checked(a, validation is not None),
+        "detection_limits": detection_limits(a),
         "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
         "candidates": [c.as_dict() for c in sorted(a.candidates, key=lambda c: -abs(c.t))],
         "model": model_info,
