@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.limits import gain_floor, share_floor
+from harness.diagnosis.limits import NOT_ENTERED, gain_floor, share_floor
 from harness.diagnosis.run import diagnose
 from harness.noise import apply_noise
 from harness.noise_presets import preset
@@ -79,7 +79,9 @@ def test_limits_of_a_pitch_null_cover_what_it_tested_and_nothing_else(pitch_null
         # an estimate that cleared its limit was withheld by another rule, which the row quotes
         assert ("withheld" in r) == (r["estimate"] >= r["limit"])
         if "withheld" in r:
-            assert r["withheld"] == by_candidate[p]["reason"] and not by_candidate[p]["selected"]
+            reason = by_candidate[p]["reason"]
+            assert r["withheld"] == (NOT_ENTERED if reason == "not entered" else reason)
+            assert not by_candidate[p]["selected"]
     cm_alpha = rows["Cm_alpha"]
     assert cm_alpha["floors"]["significance"] == pytest.approx(cand.T_IN * by_candidate["Cm_alpha"]["std_error"])
     assert cm_alpha["relative_to_model"] == pytest.approx(cm_alpha["limit"] / abs(cm_alpha["model_value"]))

@@ -93,6 +93,12 @@ def _delay_limit(a: Analysis, c: Candidate) -> dict:
     return _limit(c, {"significance": cand.T_IN * c.std_error, "practical size": practical_delay(a.prepared.dt)})
 
 
+# Why an estimate above its limit stayed out when the stepwise never entered it: its floors
+# are judged beside the final model, the stepwise's entry beside the terms entered before.
+NOT_ENTERED = ("not entered: the stepwise stopped before it (it tries the column that removes the most first and "
+               "stops at the first that fails the entry rules, at most 3 terms per axis)")
+
+
 def estimated_size(c: Candidate) -> float:
     """The size a candidate's estimate gives the effect: a coefficient error's change from the
     model's value, any other parameter's estimate."""
@@ -106,7 +112,7 @@ def _limit(c: Candidate, floors: dict[str, float]) -> dict:
            "estimate": estimated_size(c), "std_error": float(c.std_error), "rule": rule,
            "floors": {k: float(v) for k, v in floors.items()}}
     if out["estimate"] >= limit:  # the estimate cleared every floor: another rule withheld it
-        out["withheld"] = c.reason
+        out["withheld"] = NOT_ENTERED if c.reason == "not entered" else c.reason
     return out
 
 
