@@ -133,14 +133,21 @@ def test_killed_campaign_resumes_without_recomputing(tmp_path):
     proc.wait()
     before = {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in tasks.glob("*.parquet")}
     assert 8 <= len(before) < 60, len(before)
-    assert not list(tasks.glob(".*.tmp"))  # nothing half-written is visible... or left as a final file
+    for p in tasks.glob("*.parquet"):  # every visible task file is whole (a kill mid-write leaves
+        pd.read_parquet(p)             # at most a hidden .tmp, which kill -9 gives no chance to remove)
     assert subprocess.run(cmd, env=env, capture_output=True).returncode == 0
+    assert not list(tasks.glob(".*.tmp"))  # the rerun removed any temporary the kill left
     after = {p.name: (p.stat().st_mtime_ns, p.read_bytes()) for p in tasks.glob("*.parquet")}
     assert len(after) == 60
     for name, stamp in before.items():
         assert after[name] == stamp, f"task {name} was recomputed"
     import json
     assert json.loads((out / "run.json").read_text())["tasks_run"] == 60 - len(before)
+    # a temporary left by a kill in mid-write (planted: the kill above may or may not land in
+    # one) is removed by the next run, which leaves the finished tasks alone
+    (tasks / ".planted.parquet.abc123.tmp").write_bytes(b"half a parquet")
+    assert subprocess.run(cmd, env=env, capture_output=True).returncode == 0
+    assert not list(tasks.glob(".*.tmp")) and len(list(tasks.glob("*.parquet"))) == 60
     fresh = run_campaign(load_campaign(path), tmp_path / "fresh", workers=2, cache_dir=cache, progress=False)
     resumed = pd.read_parquet(out / "results.parquet")
     pd.testing.assert_frame_equal(resumed[DETERMINISTIC], fresh.results[DETERMINISTIC], check_exact=True)
