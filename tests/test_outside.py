@@ -484,3 +484,87 @@ def test_a_moment_reference_shift_on_a_lateral_maneuver_is_named_by_its_two_axes
     assert row["error"] is None and row["a"] and row["b"] and row["d"] and row["c"] == 0, (row["first"], row["false"])
     f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())["findings"][0]
     assert f["evidence"]["rival"]["set_apart"].startswith("C_m's mean carries the mistrim")
+
+
+def independent_c172x_recording(path: Path, seed: int, sim_hz: float = 100.0, duration_s: float = 25.0) -> None:
+    """Fly the package's c172x with jsbsim alone (JSBSim trim at 4,000 ft and 180 ft/s, FCS
+    disabled, step inputs written to the surfaces: stabilator 3-2-1-1 of 3°, aileron and rudder
+    doublets of 3°) and write ``path`` with white noise and a Gauss-Markov wander on the vanes,
+    reading every property after ``run()`` as a script would (JSBSim computes the forces before
+    a step integrates the states: at ``sim_hz`` = 100 the accelerometers lead by 10 ms)."""
+    import jsbsim
+    jsbsim.FGJSBBase().debug_lvl = 0
+    fdm = jsbsim.FGFDMExec(None)
+    fdm.set_debug_level(0)
+    assert fdm.load_model("c172x")
+    fdm.set_dt(1.0 / sim_hz)
+    fdm["ic/h-sl-ft"], fdm["ic/vt-fps"] = 4000.0, 180.0
+    fdm["fcs/mixture-cmd-norm"], fdm["propulsion/magneto_cmd"], fdm["propulsion/starter_cmd"] = 1.0, 3, 1
+    fdm.run_ic()
+    fdm["propulsion/set-running"] = -1
+    fdm.do_trim(1)
+    fdm["simulation/models/FGFCS/enabled"] = 0
+    surf = {"de": "fcs/elevator-pos-rad", "da": "fcs/effective-aileron-pos", "dr": "fcs/rudder-pos-rad"}
+    trim = {s: fdm[p] for s, p in surf.items()}
+    d = math.radians(3.0)
+
+    def command(t: float) -> dict:
+        out = dict(trim)
+        edges = np.cumsum([1.0, 1.5, 1.0, 0.5, 0.5])   # 3-2-1-1 in 0.5 s units from t = 1 s
+        for (a, b), sign in zip(zip(edges[:-1], edges[1:]), (1, -1, 1, -1)):
+            out["de"] += sign * d if a <= t < b else 0.0
+        for s, t0 in (("da", 7.0), ("dr", 13.0)):
+            out[s] += d if t0 <= t < t0 + 1 else -d if t0 + 1 <= t < t0 + 2 else 0.0
+        return out
+
+    mass, n_sub = fdm["inertia/mass-slugs"], int(round(sim_hz / 50))
+    rows = []
+    for k in range(int(round(duration_s * 50)) + 1):
+        for _ in range(n_sub if k else 0):
+            for s, v in command(fdm.get_sim_time() + 1.0 / sim_hz).items():
+                fdm[surf[s]] = v
+            fdm.run()
+        rows.append([k / 50.0, fdm["velocities/vt-fps"], fdm["aero/alpha-rad"], fdm["aero/beta-rad"],
+                     *(fdm[f"velocities/{a}i-rad_sec"] for a in "pqr"),
+                     fdm["attitude/phi-rad"], fdm["attitude/theta-rad"], fdm["attitude/psi-rad"],
+                     *(fdm[f"forces/fb{a}-total-lbs"] / (mass * G0) for a in "xyz"),
+                     *(fdm[surf[s]] for s in ("de", "da", "dr")), fdm["aero/qbar-psf"], fdm["position/h-sl-ft"]])
+    X = np.array(rows)
+    rng = np.random.default_rng(seed)
+    deg = math.radians(1.0)
+    sigma = ([0, 0.5, 0.1 * deg, 0.1 * deg] + [0.1 * deg] * 3 + [0.2 * deg] * 3 + [0.01] * 3 + [0.05 * deg] * 3
+             + [0.3, 5])
+    X += rng.normal(size=X.shape) * np.array(sigma)
+    a = math.exp(-0.02)  # and a Gauss-Markov wander of 0.1° (τ = 1 s) on both vanes
+    for j in (2, 3):
+        w = np.zeros(len(X))
+        for i, e in enumerate(rng.normal(scale=0.1 * deg * math.sqrt(1 - a * a), size=len(X))[1:], 1):
+            w[i] = a * w[i - 1] + e
+        X[:, j] += w
+    cols = ["t_s", "V_fps", "alpha_rad", "beta_rad", "p_rps", "q_rps", "r_rps", "phi_rad", "theta_rad", "psi_rad",
+            "ax_g", "ay_g", "az_g", "de_rad", "da_rad", "dr_rad", "qbar_psf", "h_ft"]
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        w.writerows([[f"{v:.8g}" for v in r] for r in X])
+    meta = {"format": "flight-recording/1", "aircraft": "Cessna 172 (JSBSim c172x)",
+            "geometry": {"S_ft2": fdm["metrics/Sw-sqft"], "b_ft": fdm["metrics/bw-ft"],
+                         "cbar_ft": fdm["metrics/cbarw-ft"]},
+            "mass": {"mass_slug": mass, "Ix_slugft2": fdm["inertia/ixx-slugs_ft2"],
+                     "Iy_slugft2": fdm["inertia/iyy-slugs_ft2"], "Iz_slugft2": fdm["inertia/izz-slugs_ft2"],
+                     "Ixz_slugft2": -fdm["inertia/ixz-slugs_ft2"]}}
+    path.with_suffix(".meta.json").write_text(json.dumps(meta))
+
+
+def test_a_force_drift_the_vane_wander_imitates_is_not_named(tmp_path):
+    """An independent script's c172x null (seed 21): the α vane's 1 s wander, passed through
+    the model's ∂C_Z/∂α, followed the airspeed's slow change and the stepwise entered a C_Z
+    ΔV/V (t 5.0). Beside that column (term_rules.withhold_force_drift_off_the_vane_wander) it
+    falls to t 2.6: none."""
+    from harness.diagnosis.run import diagnose
+    path = tmp_path / "c172x.csv"
+    independent_c172x_recording(path, 21)
+    result = diagnose("c172x", path, tmp_path / "out", calibrate=False)
+    assert [f["effect"] for f in result["findings"]] == ["none"]
+    drift = next(c for c in result["candidates"] if c["parameter"] == "CZ_dV")
+    assert not drift["selected"] and "vane's wander" in drift["reason"]

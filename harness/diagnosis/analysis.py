@@ -22,6 +22,7 @@ from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offse
 from harness.diagnosis.term_rules import (imitation, note_untested_coupling,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
                                           withhold_explained_by_cg, withhold_explained_by_lift,
+                                          withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane, withhold_rivals)
 from models.aircraft import Aircraft, has_propeller
 from models.replay import InitialCondition
@@ -71,7 +72,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     cands.append(off_candidate)
     # 4. delay scans; 5. per-axis stepwise
     delays = delay_scans(p, mismatch, aero, noise)
-    vane = vane_noise_columns(p, along, slope_of, V0, mismatch, None if sensor_values else gust)
+    # the vane-against-inertial difference, after the sensor corrections when there were any
+    wander_gust = turbulence_test(p)[0] if sensor_values else gust
+    vane = vane_noise_columns(p, along, slope_of, V0, mismatch, wander_gust)
     step = stepwise_fits(p, has_propeller(aircraft.model), aero, measured, mismatch, delays, vane)
     cands += aero_candidates(step.selections, delays, p.dt, step.shares)
     if step.pinned is not None:
@@ -81,6 +84,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_explained_by_lift(cands, step.selections, mismatch, p)
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
+    withhold_force_drift_off_the_vane_wander(cands, step, p, mismatch, slope_of, wander_gust, V0)
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
                     measured)
     note_untested_coupling(cands, p)
