@@ -170,14 +170,15 @@ def limits_table(limits: list[Mapping]) -> Table:
              "smallest named": f"{r.get('limit', float('nan')):.3g}",
              "standard error": f"{r.get('std_error', float('nan')):.3g}",
              "of the model's value": pct(r), "set by": r.get("rule", ""),
-             "estimate": f"{r.get('estimate', float('nan')):.3g}",
+             "estimated size": f"{r.get('estimate', float('nan')):.3g}",
              "withheld (estimate above the limit)": r.get("withheld", "")} for r in limits]
     return Table("Detection limits", pd.DataFrame(rows),
                  "Tested parameters not named, and the size their estimate (a coefficient's change from the "
-                 "model) must reach to be named: the entry t times the standard error, the practical share of "
-                 "the coefficient's excursion or the smallest sensor error worth naming, whichever is largest. "
-                 "An effect at the limit is estimated above it about half the time. Other rules (rivals, the validation maneuver) "
-                 "may still withhold a larger effect: a 'none' rules out only what lies above these.")
+                 "model) must reach to be named: the largest of the entry t times the standard error, the "
+                 "practical share of the coefficient's excursion, the stepwise's gain and the smallest sensor "
+                 "error or delay worth naming. An effect at the limit is estimated above it about half the time. "
+                 "Other rules (rivals, the validation maneuver) may still withhold a larger effect: a 'none' "
+                 "rules out only what lies above these.")
 
 
 def verdict_section(data: Mapping) -> Section:

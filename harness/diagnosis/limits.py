@@ -118,12 +118,13 @@ def _limit(c: Candidate, floors: dict[str, float]) -> dict:
 
 def detection_limits(a: Analysis) -> list[dict]:
     """For each parameter the identification maneuver tested and the diagnosis did not name,
-    the size below which it could not have been named (module docstring), as
-    ``{'effect', 'parameter', 'units', 'limit', 'estimate', 'std_error', 'rule', 'floors'}`` (a
-    coefficient error also gives its model value and the limit relative to it; an estimate
-    at or above its limit, withheld by another rule, gives that rule's words as ``withheld``); coefficient axes in
-    :data:`prepare.COEFFICIENTS` order, then the delays, then the sensors. Parameters the
-    maneuver did not test are in ``not_checked`` instead."""
+    the size its estimate must reach to be named (module docstring), as ``{'effect',
+    'parameter', 'units', 'limit', 'estimate', 'std_error', 'rule', 'floors'}`` (``estimate`` is
+    the estimated size, :func:`estimated_size`; a coefficient error also gives its model value
+    and the limit relative to it; an estimate at or above its limit, withheld by another rule,
+    gives that rule's words as ``withheld``); coefficient axes in :data:`prepare.COEFFICIENTS`
+    order, then the delays, then the sensors. Parameters the maneuver did not test are in
+    ``not_checked`` instead."""
     aero, delays, sensors = [], [], []
     for c in a.candidates:
         if c.selected or not np.isfinite(c.std_error) or c.std_error <= 0:

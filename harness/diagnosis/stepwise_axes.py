@@ -70,6 +70,15 @@ class StepwiseFits:
 VANE_NOISE_SHARE = 0.15
 
 
+def vane_error_column(slope_of, gust, V0: float, axis: str) -> np.ndarray:
+    """−∂C/∂α·e for coefficient ``axis``: what the α vane's error e passes into the mismatch of
+    a model evaluated along the vane (errors in variables), e the vane's angle less the one the
+    inertial channels integrate to, −w/V with w the kinematic residual's vertical "gust"
+    (``gust.w_fps``) and V the airspeed ``V0``; ``slope_of`` the model's slopes
+    (:func:`along.slope_function`)."""
+    return slope_of("alpha")[axis] * np.asarray(gust.w_fps, dtype=float) / V0
+
+
 def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mismatch: dict[str, np.ndarray],
                        gust=None) -> dict[str, np.ndarray]:
     """The column −C_m,α·e that the α vane's own error passes into C_m's mismatch, e the
@@ -97,7 +106,7 @@ def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mism
         gust, _ = turbulence_test(p)
     if gust.w_fps is None:
         return {}
-    column = slope_of("alpha")["Cm"] * np.asarray(gust.w_fps, dtype=float) / V0   # −C_m,α·e, e = −w/V
+    column = vane_error_column(slope_of, gust, V0, "Cm")
     inner = interior(p)
     z = mismatch["Cm"][inner]
     A = np.column_stack([column[inner], np.ones(z.size)])

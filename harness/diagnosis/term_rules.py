@@ -14,7 +14,7 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
 from harness.diagnosis.prepare import Prepared, clean_channels
 from harness.diagnosis.sensor_rules import AMBIGUOUS_T, kinematic_estimate, kinematic_std_error
-from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test
+from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test, vane_error_column
 from models.aircraft import Aircraft
 from models.replay import InitialCondition
 
@@ -105,7 +105,7 @@ def withhold_force_drift_off_the_vane_wander(cands: list[Candidate], step: Stepw
                                              mismatch: dict[str, np.ndarray], slope_of, gust, V0: float) -> None:
     """A drift term on a force axis (C_X or C_Z ∝ ΔV/V) must hold beside the α vane's own
     error passed through the model's slope, −∂C/∂α·e (e the vane's angle less the inertial
-    one, :func:`stepwise_axes.vane_noise_columns`' column for that axis).
+    one, :func:`stepwise_axes.vane_error_column` for that axis).
 
     The model is evaluated along the vane, so the vane's wander is in the force mismatch
     times the model's C_Z,α (errors in variables). A Gauss-Markov wander is slow, and over a
@@ -124,7 +124,7 @@ def withhold_force_drift_off_the_vane_wander(cands: list[Candidate], step: Stepw
         key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
         if key is None:
             continue
-        wander = slope_of("alpha")[c.channel] * np.asarray(gust.w_fps, dtype=float) / V0
+        wander = vane_error_column(slope_of, gust, V0, c.channel)
         others = [by_key[k].column[inner] for k in sel.names if k in by_key and k != key]
         others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
         fit = _refit_term(mismatch[c.channel][inner], others + [wander[inner]], by_key[key].column[inner])
