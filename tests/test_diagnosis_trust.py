@@ -1305,3 +1305,29 @@ def test_an_error_of_a_vane_the_maneuver_did_not_drive_says_nothing_of_plausibil
     # a 737 pitch null's states off the model's tables)
     from harness.diagnosis.sensor_rules import applied_sensor_values
     assert applied_sensor_values(beta, False, True, 427.4) == {"bias_alpha": 0.0135}
+
+
+def test_the_rate_gyros_common_skew_pools_their_own():
+    """sensor_rules.suspected_estimate: the three rate gyros' skews, each a weak suspicion
+    (an independent c172x null at 100 Hz: p −4.9 ± 1.4, q −4.2 ± 2.3, r −5.8 ± 2.5 ms), give
+    their inverse-variance mean and its t for the unit (1/√Σσ⁻²). One gyro that departs from
+    the mean by more than GYRO_AGREE_Z of its standard errors, or a single gyro tried, gives
+    no unit; any other parameter is the kinematic check's own estimate."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.sensor_rules import GYRO_AGREE_Z, GYRO_UNIT, suspected_estimate, unit_members
+
+    def kin(**skews):
+        return SimpleNamespace(selection=SimpleNamespace(params={}, std_errors={}, terms=[
+            SimpleNamespace(name=f"skew_{g}", estimate=v, t=v / s, std_error=s) for g, (v, s) in skews.items()]))
+
+    k = kin(p=(-4.9e-3, 1.4e-3), q=(-4.2e-3, 2.3e-3), r=(-5.8e-3, 2.5e-3))
+    w = np.array([1.4e-3, 2.3e-3, 2.5e-3]) ** -2.0
+    mean = float(np.dot(w, [-4.9e-3, -4.2e-3, -5.8e-3]) / w.sum())
+    v, t, se = suspected_estimate(k, GYRO_UNIT)
+    assert v == pytest.approx(mean) and se == pytest.approx(w.sum() ** -0.5) and t == pytest.approx(abs(mean) / se)
+    assert 4.0 < t < 5.0 and unit_members(k, GYRO_UNIT) == ("skew_p", "skew_q", "skew_r")
+    assert suspected_estimate(k, "skew_q") == pytest.approx((-4.2e-3, 4.2 / 2.3, 2.3e-3))
+    apart = kin(p=(-4.9e-3, 1.0e-3), q=(+4.0e-3, 1.0e-3))   # each 4.45 standard errors from the mean
+    assert GYRO_AGREE_Z < 4.45 and suspected_estimate(apart, GYRO_UNIT) is None
+    assert suspected_estimate(kin(q=(-4.2e-3, 2.3e-3)), GYRO_UNIT) is None

@@ -12,8 +12,8 @@ from harness.diagnosis import corroborate
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.gust_rules import mode_candidate
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
-from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_estimate, kinematic_rival, kinematic_std_error,
-                                            kinematics_plausible, sensor_verdict)
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_rival, kinematics_plausible, sensor_verdict,
+                                            suspected_estimate)
 from harness.diagnosis.spectra import FISHER_P, MODE_CONFIRM_P, peak_at, predicted_peak_p, untestable_at
 from models.hidden import SENSOR_EFFECTS
 
@@ -107,10 +107,10 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
         name = suspicion["parameter"]
         if "shape" in getattr(by_name.get(name), "details", {}):
             continue
-        here, there = kinematic_estimate(a.kinematic, name), kinematic_estimate(av.kinematic, name)
+        here, there = suspected_estimate(a.kinematic, name), suspected_estimate(av.kinematic, name)
         if here is None or there is None or (there[1] >= AMBIGUOUS_T and np.sign(there[0]) == np.sign(here[0])):
             continue
-        se_here, se_there = kinematic_std_error(a.kinematic, name), kinematic_std_error(av.kinematic, name)
+        se_here, se_there = here[2], there[2]
         apart = float(np.hypot(se_here, se_there))
         if not (np.isfinite(apart) and apart > 0) or abs(here[0] - there[0]) < UNREPLICATED_Z * apart:
             continue

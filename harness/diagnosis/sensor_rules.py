@@ -258,6 +258,47 @@ def kinematic_std_error(kin: KinematicResult, name: str) -> float:
     return float(term.std_error)
 
 
+# The rate gyros are one instrument: a time skew of the unit (its clock, its filter, or a
+# simulation that integrates the rotational rates apart from the rest) shows on all three.
+# JSBSim integrates its rotational rates by rectangular Euler (its default): a script that
+# reads the properties after each step records gyros the kinematics put 3-7 ms off the vanes,
+# each of the three often below :data:`AMBIGUOUS_T` alone (an independent script's c172x null
+# at 100 Hz: p −4.9 ± 1.4, q −4.2 ± 2.3, r −5.8 ± 2.5 ms; together −4.9 ± 1.1 ms, t 4.5).
+GYROS = ("p", "q", "r")
+GYRO_UNIT = "skew_pqr"
+# Each member's estimate must lie within this many of its own standard errors of the unit's.
+GYRO_AGREE_Z = 2.0
+
+
+def unit_members(kin: KinematicResult, name: str) -> tuple[str, ...]:
+    """The kinematic parameters suspicion ``name`` stands for: the gyros' own skews for
+    :data:`GYRO_UNIT`, else ``name`` itself."""
+    if name != GYRO_UNIT:
+        return (name,)
+    return tuple(f"skew_{g}" for g in GYROS if kinematic_estimate(kin, f"skew_{g}") is not None)
+
+
+def suspected_estimate(kin: KinematicResult, name: str) -> tuple[float, float, float] | None:
+    """A suspicion's estimate, |t| and standard error: a kinematic parameter's
+    (:func:`kinematic_estimate`), or for :data:`GYRO_UNIT` the inverse-variance mean of the
+    gyros' skews when at least two were tried and each lies within :data:`GYRO_AGREE_Z` of
+    its standard errors of the mean (None otherwise)."""
+    if name != GYRO_UNIT:
+        found = kinematic_estimate(kin, name)
+        return None if found is None else (found[0], found[1], kinematic_std_error(kin, name))
+    members = unit_members(kin, name)
+    if len(members) < 2:
+        return None
+    values = [kinematic_estimate(kin, m)[0] for m in members]
+    errors = [kinematic_std_error(kin, m) for m in members]
+    if not all(np.isfinite(e) and e > 0 for e in errors):
+        return None
+    mean, se = inverse_variance_mean(values, errors)
+    if any(abs(v - mean) > GYRO_AGREE_Z * e for v, e in zip(values, errors)):
+        return None
+    return mean, abs(mean) / se, se
+
+
 # How far (in combined standard errors) the kinematics' own estimate of a vane's scale may
 # sit from the scale the coefficient mismatch asks for before they refute it. The mismatch's
 # k and the kinematic one come from independent equations; on the project sweep a C_Z,α error

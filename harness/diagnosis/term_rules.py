@@ -4,6 +4,7 @@ wandering α vane, a rival term, a sensor error or a gyro skew."""
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import butter, filtfilt
 
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
@@ -11,9 +12,11 @@ from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import INERTIAL_CHANNELS, corrected_recording, inertial_beta, interior, model_along
 from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.gust_rules import turbulence_test
 from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
 from harness.diagnosis.prepare import Prepared, clean_channels
-from harness.diagnosis.sensor_rules import AMBIGUOUS_T, kinematic_estimate, kinematic_std_error
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYRO_UNIT, GYROS, kinematic_estimate, kinematic_std_error,
+                                            suspected_estimate, unit_members)
 from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test, vane_error_column
 from models.aircraft import Aircraft
 from models.replay import InitialCondition
@@ -132,6 +135,46 @@ def withhold_force_drift_off_the_vane_wander(cands: list[Candidate], step: Stepw
             c.selected = False
             c.reason = (f"entered, but the α vane's wander passed through the model's ∂{c.channel}/∂α would "
                         f"imitate it (beside that column, t = {fit[1]:.1f})")
+
+
+# Below this frequency the α vane's error column is mostly the inertial integration's own
+# drift: the accelerometers' white noise, integrated, is a random walk whose spectrum rises as
+# 1/f² down to the gust estimate's high-pass (:data:`spectra.GUST_HIGHPASS_HZ`, 0.05 Hz),
+# while a vane's Gauss-Markov wander (τ about 1 s) is flat there.
+VANE_COLUMN_CHECK_HZ = 0.1
+
+
+def withhold_off_the_integration_drift(cands: list[Candidate], step: StepwiseFits, p: Prepared,
+                                       mismatch: dict[str, np.ndarray]) -> None:
+    """A term entered beside the α vane's error column (``vane_alpha_noise``,
+    :func:`stepwise_axes.vane_noise_columns`) must hold (|t| >= the entry t) with that column
+    high-passed at :data:`VANE_COLUMN_CHECK_HZ`.
+
+    The column is the vane's angle less the one the gyros and accelerometers integrate to.
+    Its slowest part is that integration's drift, which the mismatch does not carry; fitted
+    (at about one), the column puts the drift into the fit, and over a 25 s record a drift
+    follows a slow shape by chance. An independent script's c172x null (seed 4, 100 Hz) drew
+    a C_m α² of 3.3 (t 5.4): without the column t 0.1, with it high-passed at 0.1 Hz t 1.8;
+    that record's inertial angle alone, noise-free vane, fitted α² at R² 0.4."""
+    inner = interior(p)
+    b, a = butter(2, VANE_COLUMN_CHECK_HZ, btype="highpass", fs=1.0 / p.dt)
+    for c in cands:
+        nuisances = step.nuisances.get(c.channel or "", {})
+        if not (c.selected and "vane_alpha_noise" in nuisances and c.channel in step.selections):
+            continue
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
+        if key is None:
+            continue
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k != key]
+        others += [v[inner] for n, v in nuisances.items() if n != "vane_alpha_noise" and np.ptp(v[inner]) > 0]
+        quick = filtfilt(b, a, nuisances["vane_alpha_noise"])
+        fit = _refit_term(mismatch[c.channel][inner], others + [quick[inner]], by_key[key].column[inner])
+        if fit is not None and abs(fit[1]) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"entered, but only beside the α vane's error column's slowest part, the inertial "
+                        f"integration's own drift (with the column high-passed at {VANE_COLUMN_CHECK_HZ:g} Hz, "
+                        f"t = {fit[1]:.1f})")
 
 
 def withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: StepwiseFits, p: Prepared, aircraft: Aircraft,
@@ -398,36 +441,66 @@ IMITATION_SHARE = 0.5
 
 
 def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
-              mismatch: dict[str, np.ndarray], step: StepwiseFits):
+              mismatch: dict[str, np.ndarray], step: StepwiseFits, slope_of=None, V0: float | None = None):
     """``imitated(c, name)``: the largest change of term ``c``'s parameter, in the direction of
     its own change, that sensor error ``name`` imitates anywhere within :data:`IMITATION_Z`
     standard errors of its kinematic estimate; None when it cannot be computed.
 
     The imitation is computed, not assumed: the channels are corrected by the kinematic
-    estimate v, the measured and the model's coefficients evaluated again, and the mismatch's
-    change fitted on the term's column beside the axis's other selected terms and a constant
-    (ordinary least squares): δ per v, linear in the error's size. (A 2.3 % q-scale suspicion,
-    kinematic t = 2.6, withheld a C_m,q̂ change of −5.9 on the model's −0.95 at 380 ft/s: such a
-    scale imitates 0.4 at most.)"""
+    estimate v, the measured and the model's coefficients evaluated again, and the axis's fit
+    (the term, the axis's other selected terms, its nuisance columns and a constant; ordinary
+    least squares) made on both: δ per v, linear in the error's size. (A 2.3 % q-scale
+    suspicion, kinematic t = 2.6, withheld a C_m,q̂ change of −5.9 on the model's −0.95 at
+    380 ft/s: such a scale imitates 0.4 at most.)
+
+    The α vane's error column (:func:`stepwise_axes.vane_noise_columns`), where it is in the
+    fit, is built again from the corrected channels (``slope_of`` and ``V0`` as it was built;
+    without them it is kept as it was): it is the vane's angle less the one the gyros and
+    accelerometers integrate to, so a gyro's time skew is in it, and through it in the fit,
+    though the mismatch itself hardly carries the skew. JSBSim's rotational rates, integrated
+    by rectangular Euler from the moments of the step before, lag those moments by half a
+    step (5 ms at 100 Hz); an independent c172x script's nulls then gave a C_m,α̇ of +1.1 to
+    +1.4 (t 5.4–9.7) that the kinematics' q skew (−5 to −7 ms, t 4.3–5.2) explained through
+    this column alone (probe 22, 5 Dec 2026)."""
     inner = interior(p)
+    vane_key = "vane_alpha_noise"
+
+    def refit(z: np.ndarray, cols: list[np.ndarray]) -> float:
+        A = np.column_stack(cols + [np.ones(z.size)])
+        return float(np.linalg.lstsq(A, z, rcond=None)[0][0])
 
     def imitated(c: Candidate, name: str) -> float | None:
-        found = kinematic_estimate(kin, name)
+        found = suspected_estimate(kin, name)
         sel, by_key = step.selections.get(c.channel, (None, {}))
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
         change = c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
         if found is None or key is None or not found[0] or not change:
             return None
-        v, t = found
-        changed = model_along(corrected_recording(p, kin, {name: v}), aircraft, ic, inertial_from=p).mismatch()
-        z = (mismatch[c.channel] - changed[c.channel])[inner]   # what an error of size v adds
+        v, t, _ = found
+        corrected = corrected_recording(p, kin, {m: v for m in unit_members(kin, name)})
+        changed = model_along(corrected, aircraft, ic, inertial_from=p).mismatch()
         cols = [by_key[key].column[inner]] + [by_key[k].column[inner] for k in sel.names if k != key and k in by_key]
-        A = np.column_stack(cols + [np.ones(z.size)])
-        per_v = float(np.linalg.lstsq(A, z, rcond=None)[0][0]) / v
+        nuisances = step.nuisances.get(c.channel, {})
+        fixed = [x[inner] for n, x in nuisances.items() if n != vane_key and np.ptp(x[inner]) > 0]
+        if vane_key in nuisances:
+            rebuilt = nuisances[vane_key]
+            if slope_of is not None and V0 is not None:
+                rebuilt = vane_error_column(slope_of, turbulence_test(corrected)[0], V0, c.channel)
+            before = refit(mismatch[c.channel][inner], cols + fixed + [nuisances[vane_key][inner]])
+            after = refit(changed[c.channel][inner], cols + fixed + [rebuilt[inner]])
+        else:
+            before = refit(mismatch[c.channel][inner], cols + fixed)
+            after = refit(changed[c.channel][inner], cols + fixed)
+        per_v = (before - after) / v   # what an error of size v adds to the term's estimate
         sigma = abs(v) / t if t > 0 else np.inf
         ends = (v - IMITATION_Z * sigma, v + IMITATION_Z * sigma)
         return max(per_v * e * np.sign(change) for e in ends)
     return imitated
+
+
+def _named(rival: str) -> str:
+    """A suspicion as the reasons name it."""
+    return f"{rival}, the rate gyros' common time skew" if rival == GYRO_UNIT else rival
 
 
 def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None) -> None:
@@ -437,16 +510,19 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     reason names the rival, and ``details['suspicion']`` keeps it for the validation maneuver
     (:func:`replication.lift_unreplicated_suspicions`)."""
 
+    asked: set[tuple[int, str]] = set()  # (term, rival) found not to explain it
+
     def explains(c: Candidate, rival: str, t: float) -> bool:
-        if c.details.get("sensor_suspect", {}).get("parameter") == rival:
+        if (id(c), rival) in asked:
             return False  # asked already (the regressor's sensor and the coefficient's)
         size = None if imitated is None else imitated(c, rival)
         change = abs(c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate)
         if size is None or size >= IMITATION_SHARE * change:
             return True
+        asked.add((id(c), rival))
         c.details["sensor_suspect"] = {"parameter": rival, "imitates_at_most": size, "change": change}
-        c.reason += (f"; the kinematics suspect {rival} (t = {t:.1f}), which would imitate at most {size:.2g} of "
-                     f"this change of {change:.3g}")
+        c.reason += (f"; the kinematics suspect {_named(rival)} (t = {t:.1f}), which would imitate at most "
+                     f"{size:.2g} of this change of {change:.3g}")
         return False
     suspects: dict[str, tuple[str, float]] = {}
     for name, sp in kin.parameters.items():
@@ -455,31 +531,41 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             t = found[1]
             if t >= AMBIGUOUS_T and t > suspects.get(sp.channel, ("", 0.0))[1]:
                 suspects[sp.channel] = (name, t)
+    unit = suspected_estimate(kin, GYRO_UNIT)  # the rate gyros' common skew, beside each one's own
+    units = {g: (GYRO_UNIT, unit[1]) for g in GYROS
+             if unit is not None and unit[1] >= AMBIGUOUS_T and f"skew_{g}" in unit_members(kin, GYRO_UNIT)}
+
+    def rivals_of(channel: str | None) -> list[tuple[str, float]]:
+        return [r for r in (suspects.get(channel or ""), units.get(channel or "")) if r is not None]
+
     for c in cands:
         if c.selected and c.effect == "control_delay":
             _withhold_skewed_delay(c, kin)
         if not (c.selected and c.effect == "coefficient_error"):
             continue
         channel = cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
-        if channel in suspects and explains(c, *suspects[channel]):
-            rival, t = suspects[channel]
+        found = next((r for r in rivals_of(channel) if explains(c, *r)), None)
+        if found is not None:
+            rival, t = found
             c.selected = False
             c.details["sensor_rival"] = rival
             c.details["suspicion"] = {"parameter": rival, "t": t}
-            c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({rival}, "
+            c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({_named(rival)}, "
                         f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
     for c in cands:  # the sensor the coefficient itself is measured with
         sensor = DEPENDENT_SENSOR.get(c.channel or "")
-        if not (c.selected and sensor in suspects and c.test.startswith("stepwise")):
+        if not (c.selected and rivals_of(sensor) and c.test.startswith("stepwise")):
             continue
-        rival, t = suspects[sensor]
         rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
-        if rival.startswith("skew") and not (c.effect == "unsteady_alphadot" or rate_term):
-            continue  # a lag imitates terms that follow the coefficient's rate of change, not its level
-        if not explains(c, rival, t):
+        # a lag imitates terms that follow the coefficient's rate of change, not its level
+        lag_shaped = c.effect == "unsteady_alphadot" or rate_term
+        found = next((r for r in rivals_of(sensor) if (lag_shaped or not r[0].startswith("skew")) and explains(c, *r)),
+                     None)
+        if found is None:
             continue
+        rival, t = found
         c.selected = False
         c.details["sensor_rival"] = rival
         c.details["suspicion"] = {"parameter": rival, "t": t}
         c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
-                    f"({rival}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
+                    f"({_named(rival)}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
