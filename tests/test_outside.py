@@ -597,3 +597,31 @@ def test_a_power_of_alpha_on_the_integration_drift_is_not_named(tmp_path):
     assert [f["effect"] for f in result["findings"]] == ["none"]
     power = next(c for c in result["candidates"] if c["parameter"] == "Cm_alpha2")
     assert abs(power["t"]) >= 5.0 and not power["selected"] and "integration's own drift" in power["reason"]
+
+
+@pytest.mark.parametrize("factor", [1.2, 0.5])
+def test_a_time_column_the_gyros_disagree_with_is_refused(tmp_path, factor):
+    """A recording whose time column is stretched (60 Hz data stamped at 50 Hz: 1.2) or
+    squeezed (0.5) is refused with exit status 2 before anything is fitted
+    (verdict.check_time_base): its bank and pitch angles change 1/factor times as fast as the
+    gyros say (kinematics.time_base_ratio), beyond any common gyro scale error. The record as
+    written reads one to within 2 %."""
+    import pandas as pd
+
+    from harness.diagnosis.kinematics import time_base_ratio
+    from harness.diagnosis.prepare import instruments_at_cg, prepare
+    from harness.recording_io import read_recording
+    path = tmp_path / "c172x.csv"
+    independent_c172x_recording(path, 3)
+    k, se = time_base_ratio(prepare(instruments_at_cg(read_recording(path))))
+    assert abs(k - 1.0) < 0.02 and se < 0.01
+    wrong = tmp_path / "stamped.csv"
+    df = pd.read_csv(path)
+    df["t_s"] = df["t_s"] * factor
+    df.to_csv(wrong, index=False)
+    wrong.with_suffix(".meta.json").write_text(path.with_suffix(".meta.json").read_text())
+    k, _ = time_base_ratio(prepare(instruments_at_cg(read_recording(wrong))))
+    assert k == pytest.approx(1.0 / factor, rel=0.02)
+    r = subprocess.run([sys.executable, "-m", "harness", "diagnose", "--model", "c172x", "--recording", str(wrong),
+                        "--out", str(tmp_path / "out"), "--no-calibrate"], capture_output=True, text=True)
+    assert r.returncode == 2 and "time column cannot be right" in r.stderr and "Traceback" not in r.stderr

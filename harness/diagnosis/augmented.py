@@ -20,6 +20,7 @@ from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
 from harness.diagnosis.validation import after_mismatch
+from harness.diagnosis.verdict import check_time_base
 from harness.executors import LocalPool
 from models.aircraft import Aircraft
 from models.constants import SURFACES
@@ -135,6 +136,7 @@ def analysed(rec, role: str, aircraft: Aircraft) -> tuple[Prepared, Analysis, Re
     """One maneuver prepared, analysed and replayed as the model is (a unit of work a second
     process can take)."""
     p = prepare(rec, role)
+    check_time_base(p)
     a = analyse(p, aircraft, initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude))
     return p, a, replay_before(p, aircraft, a)
 

@@ -370,3 +370,63 @@ def corrected_channels(raw: dict[str, np.ndarray], p: Prepared, params: dict[str
     for name, v in values.items():
         ch = params[name].correct(ch, p, v)
     return ch
+
+
+# A recording's time column and its gyros must agree: the recorded attitudes' change over the
+# change the gyros give them is one whatever the instruments' biases and skews. Beyond this
+# ratio's distance from one the time column is wrong (a sample rate written wrong on export:
+# 60 Hz data stamped at 50 Hz read 0.835), and every derivative the diagnosis takes with it.
+# Real data stay inside: the Tu-144's (SIDPAC) bank and pitch angles against its gyros read
+# 0.89; the sweeps' recordings, where well determined, 0.93-1.07.
+TIME_BASE_TOLERANCE = 0.15
+# ... and the ratio must stand this many standard errors from one.
+TIME_BASE_Z = 5.0
+
+
+def time_base_ratio(p: Prepared) -> tuple[float, float] | None:
+    """The recorded attitudes' change over the change the gyros give them, integrated over
+    the time column (the φ and θ equations of the module docstring; not the heading, which a
+    recording may give as magnetic or as the track: the Twin Otter's disagrees with its
+    gyros by a ratio of −1.1 and −0.3 where its bank angle agrees to 1.06 and 1.00): the
+    least-squares ratio k in angle = k·∫rate dt + a + b·t (a constant and a trend per angle
+    take up its start and a gyro bias) and its standard error (white residuals); None without
+    the attitudes, or where they hardly moved. Integrated, the gyros' noise is a small random
+    walk beside the angles' excursion, where differentiated angles against the rates would
+    read the noise as a ratio under one."""
+    ch = p.raw
+    if not all(c in ch for c in ("phi", "theta", "p", "q", "r")):
+        return None
+    P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
+    pairs = [(phi, P + np.tan(th) * (Q * np.sin(phi) + R * np.cos(phi))),
+             (th, Q * np.cos(phi) - R * np.sin(phi))]
+    t = np.arange(p.n) * p.dt
+    ys, xs = [], []
+    for angle, rate in pairs:
+        integral = _integral(rate, p.dt)
+        A = np.column_stack([np.ones(p.n), t])
+        ys.append(angle - A @ np.linalg.lstsq(A, angle, rcond=None)[0])   # the angle, and its integral,
+        xs.append(integral - A @ np.linalg.lstsq(A, integral, rcond=None)[0])  # each less a line
+    y, x = np.concatenate(ys), np.concatenate(xs)
+    sxx = float(x @ x)
+    if sxx <= 0.0:
+        return None
+    k = float(x @ y) / sxx
+    resid = y - k * x
+    se = float(np.sqrt(resid @ resid / max(y.size - 1, 1) / sxx))
+    return k, se
+
+
+def time_base_problem(p: Prepared) -> str:
+    """Why the recording's time column cannot be right ('' when it can): the attitudes change
+    at a ratio to what the gyros give (:func:`time_base_ratio`) further from one than
+    :data:`TIME_BASE_TOLERANCE` and :data:`TIME_BASE_Z` standard errors."""
+    found = time_base_ratio(p)
+    if found is None:
+        return ""
+    k, se = found
+    if abs(k - 1.0) <= TIME_BASE_TOLERANCE or abs(k - 1.0) <= TIME_BASE_Z * se:
+        return ""
+    return (f"its attitudes change {k:.3f} ± {se:.3f} times as fast as its gyros say (over the time column "
+            f"t_s, sampled at {1.0 / p.dt:.4g} Hz): the sample times look {1.0 / k:.3f} times what they were; "
+            f"a scale error common to the gyros is not plausible beyond {100 * TIME_BASE_TOLERANCE:.0f} %. "
+            "Check the time column and the sample rate")

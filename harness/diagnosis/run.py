@@ -18,9 +18,9 @@ from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.prepare import instruments_at_cg, prepare
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
 from harness.diagnosis.validation import undecided, validation_check
-from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, chosen_findings,
-                                       excited_axes, finding_dict, focus_axis, located_paragraph, none_finding,
-                                       not_checked, remaining_mismatch)
+from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, check_time_base,
+                                       chosen_findings, excited_axes, finding_dict, focus_axis, located_paragraph,
+                                       none_finding, not_checked, remaining_mismatch)
 from harness.executors import LocalPool
 from harness.recording_io import read_recording
 from models.aircraft import MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument, nominal_root
@@ -207,6 +207,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     if validation is not None and pool is not None:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     p = prepare(recs["identification"], "identification")
+    check_time_base(p)
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude)
     a = analyse(p, aircraft, ic)
     check_model_represents(a, model)

@@ -9,6 +9,7 @@ from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import interior
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.gust_rules import vane_wander
+from harness.diagnosis.kinematics import time_base_problem
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
 from models.aircraft import Aircraft
@@ -263,6 +264,21 @@ LIFT_FACTOR = 1.5
 # aircraft (the F-16's S is 300 ft², the 737's 1,171 ft², the Twin Otter's 420 ft² in both the
 # SIDPAC file and JSBSim's DHC6).
 GEOMETRY_FACTOR = 1.25
+
+
+def check_time_base(p: Prepared) -> None:
+    """Refuse a recording whose time column disagrees with its gyros
+    (:func:`kinematics.time_base_problem`): every derivative the diagnosis takes would be off
+    by the same factor, and each coefficient with it.
+
+    Raises
+    ------
+    DiagnosisError
+        Naming the maneuver, the ratio found and what to check.
+    """
+    why = time_base_problem(p)
+    if why:
+        raise DiagnosisError(f"the {p.name} recording's time column cannot be right: {why}")
 
 
 def check_model_represents(a: Analysis, model: str) -> None:
