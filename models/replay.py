@@ -15,7 +15,7 @@ import numpy as np
 
 from models.aircraft import Aircraft, has_propeller, load_fdm
 from models.conditions import FlightCondition
-from models.flight import FlightHistory, fly
+from models.flight import FlightError, FlightHistory, fly
 from models.hidden import hidden_root, needs_copy
 from models.trim import TrimError, TrimPoint, trim
 from models.truth import CoefficientProbe, central_differences, differencing_instance
@@ -244,8 +244,12 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
             out[c] = out[c] + unsteady.get(f"{c}_alphadot", 0.0) * adot_hat
     bad = [c for c, v in out.items() if not np.all(np.isfinite(v))]
     if bad:
-        raise ValueError(f"the model's aerodynamics are not finite along the recording ({', '.join(bad)}); "
-                         "the recorded states leave the model's tables")
+        k = int(np.argmax(~np.all(np.isfinite(np.vstack([out[c] for c in bad])), axis=0)))
+        raise FlightError(
+            f"the model's aerodynamics are not finite along the recording ({', '.join(bad)}) from sample {k + 1} "
+            f"(α {math.degrees(cols['alpha'][k]):.1f}°, β {math.degrees(cols['beta'][k]):.1f}°, "
+            f"V {cols['V'][k]:.0f} ft/s, h {h[k]:.0f} ft): the recorded states leave the model's tables "
+            "(a departure from controlled flight, or another aircraft's envelope)")
     return AeroAlong(coefficients=out, derivatives=derivatives, unsteady=unsteady, trim=tp, trim_failed=trim_failed,
                      propulsion=propulsion)
 

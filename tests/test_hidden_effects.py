@@ -95,3 +95,22 @@ def test_cross_coupling_in_abs_beta_is_even_in_sideslip():
     assert added - base == pytest.approx([0.3 * 0.05, 0.0, 0.3 * 0.05], abs=1e-9)
     with pytest.raises(ValueError, match="beta_abs"):
         HiddenEffect("cross_coupling", 0.3, coefficient="Cl", regressor="beta")
+
+
+def test_aerodynamics_that_are_not_finite_along_a_recording_are_a_flight_error():
+    """models.replay.aero_along: where the model's coefficients are not finite along the
+    recorded states (a departure a script flew the F-16 into, 20,000 ft and 650 ft/s with its
+    FCS off, ran α through ±180°) the error is a FlightError (a user error: exit status 2, no
+    traceback), naming the first such sample and its state. Here the c172x's α̇ terms meet an
+    α̇ that is not a number at the second sample."""
+    from models.aircraft import library_xml
+    from models.flight import FlightError
+    from models.replay import InitialCondition, aero_along
+    ic = InitialCondition(4_000.0, 180.0)
+    n = 3
+    states = {"V": np.full(n, 180.0), "alpha": np.full(n, 0.03), "beta": np.zeros(n), "p": np.zeros(n),
+              "q": np.zeros(n), "r": np.zeros(n), "phi": np.zeros(n), "theta": np.full(n, 0.03)}
+    surfaces = {"de": np.full(n, -0.02), "da": np.zeros(n), "dr": np.zeros(n)}
+    with pytest.raises(FlightError, match=r"not finite along the recording \(.*Cm\) from sample 2 "
+                                          r"\(α 1\.7°, β 0\.0°, V 180 ft/s, h 4000 ft\)"):
+        aero_along(Aircraft(str(library_xml("c172x"))), ic, states, surfaces, alphadot=np.array([0.0, np.nan, 0.0]))

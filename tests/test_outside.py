@@ -625,3 +625,18 @@ def test_a_time_column_the_gyros_disagree_with_is_refused(tmp_path, factor):
     r = subprocess.run([sys.executable, "-m", "harness", "diagnose", "--model", "c172x", "--recording", str(wrong),
                         "--out", str(tmp_path / "out"), "--no-calibrate"], capture_output=True, text=True)
     assert r.returncode == 2 and "time column cannot be right" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_a_recording_too_short_to_diagnose_is_a_user_error(tmp_path):
+    """A 6 s record stamped 50 times too fast (0.12 s) is refused with exit status 2 naming
+    its length (harness.diagnosis.prepare raises a UserError); it was reported as an internal
+    error before."""
+    import pandas as pd
+    path = tmp_path / "c172x.csv"
+    independent_c172x_recording(path, 3, duration_s=6.0)
+    df = pd.read_csv(path)
+    df["t_s"] = df["t_s"] / 50.0
+    df.to_csv(path, index=False)
+    r = subprocess.run([sys.executable, "-m", "harness", "diagnose", "--model", "c172x", "--recording", str(path),
+                        "--out", str(tmp_path / "out"), "--no-calibrate"], capture_output=True, text=True)
+    assert r.returncode == 2 and "needs at least 4 s" in r.stderr and "internal error" not in r.stderr

@@ -13,6 +13,7 @@ from estimators.smoothing import optimal_fourier_smoother, sine_series_derivativ
 from harness.isa import density_altitude_ft
 from maneuvers.recording import Recording
 from models.constants import BODY_COEFFICIENTS, SURFACES
+from models.errors import UserError
 from models.hidden import vane_shift
 from models.replay import START_WINDOW_S
 
@@ -270,15 +271,16 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
 
     Raises
     ------
-    ValueError
-        When the recording is too short (under 4 s) or lacks what Eqs. 1-5 need.
+    UserError
+        When the recording is too short (under 4 s) or lacks what Eqs. 1-5 need (a user
+        error: exit status 2 on the command line).
     """
     rec = instruments_at_cg(rec)
     raw = _channels(rec)
     t = rec.data["t_s"].to_numpy(dtype=float)
     t = t - t[0]
     if t[-1] < 4.0:
-        raise ValueError(f"recording {rec.name!r} is {t[-1]:.1f} s long; the diagnosis needs at least 4 s")
+        raise UserError(f"recording {rec.name!r} is {t[-1]:.1f} s long; the diagnosis needs at least 4 s")
     dt = float((t[-1] - t[0]) / (t.size - 1))
     assumptions = list(_stand_ins(raw, rec.meta, tuple(rec.data.columns)))
     fits, filtered = _own_smoothing(raw, dt)
@@ -298,7 +300,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     try:
         mass = {k: np.asarray(v, dtype=float) for k, v in rec.mass_at().items()}
     except (KeyError, ValueError) as exc:
-        raise ValueError(f"recording {rec.name!r} lacks mass properties Eqs. 1-5 need: {exc}") from exc
+        raise UserError(f"recording {rec.name!r} lacks mass properties Eqs. 1-5 need: {exc}") from exc
     measured = measured_coefficients(smooth, deriv, rec.meta, mass)
     driven = maneuver_driven({c: x[interior_slice(t.size, dt)] for c, x in smooth.items()}, noise, w, excited)
     moved = drifted_states(smooth, noise, w, k, driven)
