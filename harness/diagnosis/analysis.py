@@ -19,7 +19,8 @@ from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_par
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns)
-from harness.diagnosis.term_rules import (imitation, note_untested_coupling, withhold_off_the_integration_drift,
+from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, imitation, note_untested_coupling,
+                                          withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
                                           withhold_explained_by_cg, withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
@@ -89,7 +90,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
                     measured)
     note_untested_coupling(cands, p)
-    withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0))
+    column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
+    withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0), column_sensors)
     if turbulent:
         withhold_in_turbulence(cands)
     else:

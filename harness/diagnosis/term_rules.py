@@ -498,17 +498,29 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
     return imitated
 
 
+# The channels the α vane's error column is integrated from, beyond the gyros and the vane:
+# a skew or scale of theirs is in the column, and through it in the axis's fit.
+VANE_COLUMN_SENSORS = ("az",)
+
+
 def _named(rival: str) -> str:
     """A suspicion as the reasons name it."""
     return f"{rival}, the rate gyros' common time skew" if rival == GYRO_UNIT else rival
 
 
-def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None) -> None:
+def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None,
+                       column_sensors: dict[str, tuple[str, ...]] | None = None) -> None:
     """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
     channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
     kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
     reason names the rival, and ``details['suspicion']`` keeps it for the validation maneuver
-    (:func:`replication.lift_unreplicated_suspicions`)."""
+    (:func:`replication.lift_unreplicated_suspicions`).
+
+    The sensors an axis is measured with are its own (:data:`DEPENDENT_SENSOR`) and, per axis
+    in ``column_sensors``, those its nuisance columns are built from: the α vane's error
+    column (:func:`stepwise_axes.vane_noise_columns`) integrates a_z (:data:`VANE_COLUMN_SENSORS`).
+    An independent c172x script's pitch null drew a C_m,α̇ of +1.16 (t 6.0) that the q gyro's
+    suspected skew imitated 0.57 of (half: 0.58) and its a_z skew (9.8 ± 3.2 ms, t 3.0) more."""
 
     asked: set[tuple[int, str]] = set()  # (term, rival) found not to explain it
 
@@ -521,7 +533,8 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             return True
         asked.add((id(c), rival))
         c.details["sensor_suspect"] = {"parameter": rival, "imitates_at_most": size, "change": change}
-        c.reason += (f"; the kinematics suspect {_named(rival)} (t = {t:.1f}), which would imitate at most "
+        asks = "suspect" if t >= AMBIGUOUS_T else "do not rule out"
+        c.reason += (f"; the kinematics {asks} {_named(rival)} (t = {t:.1f}), which would imitate at most "
                      f"{size:.2g} of this change of {change:.3g}")
         return False
     suspects: dict[str, tuple[str, float]] = {}
@@ -538,6 +551,12 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     def rivals_of(channel: str | None) -> list[tuple[str, float]]:
         return [r for r in (suspects.get(channel or ""), units.get(channel or "")) if r is not None]
 
+    def unruled_skews(channel: str | None) -> list[tuple[str, float]]:
+        """The channel's own skew and, for a gyro, the gyros' common one, whatever their t."""
+        names = [f"skew_{channel}"] + ([GYRO_UNIT] if channel in GYROS else [])
+        found = [(n, suspected_estimate(kin, n)) for n in names]
+        return [(n, e[1]) for n, e in found if e is not None and e[0]]
+
     for c in cands:
         if c.selected and c.effect == "control_delay":
             _withhold_skewed_delay(c, kin)
@@ -552,20 +571,30 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             c.details["suspicion"] = {"parameter": rival, "t": t}
             c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({_named(rival)}, "
                         f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
-    for c in cands:  # the sensor the coefficient itself is measured with
-        sensor = DEPENDENT_SENSOR.get(c.channel or "")
-        if not (c.selected and rivals_of(sensor) and c.test.startswith("stepwise")):
-            continue
+    for c in cands:  # the sensors the coefficient itself is measured with
+        sensors = (DEPENDENT_SENSOR.get(c.channel or ""),) + (column_sensors or {}).get(c.channel or "", ())
         rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
         # a lag imitates terms that follow the coefficient's rate of change, not its level
         lag_shaped = c.effect == "unsteady_alphadot" or rate_term
-        found = next((r for r in rivals_of(sensor) if (lag_shaped or not r[0].startswith("skew")) and explains(c, *r)),
-                     None)
+        rivals = [(r, sensor) for sensor in sensors for r in rivals_of(sensor)]
+        if lag_shaped:  # and a skew need not be suspected to be there: one not ruled out is asked too
+            rivals += [(r, sensor) for sensor in sensors for r in unruled_skews(sensor)
+                       if (r[0], sensor) not in [(x[0], y) for x, y in rivals]]
+        if not (c.selected and rivals and c.test.startswith("stepwise")):
+            continue
+        found = next(((r, sensor) for r, sensor in rivals
+                      if (lag_shaped or not r[0].startswith("skew")) and explains(c, *r)), None)
         if found is None:
             continue
-        rival, t = found
+        (rival, t), sensor = found
         c.selected = False
         c.details["sensor_rival"] = rival
         c.details["suspicion"] = {"parameter": rival, "t": t}
-        c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
-                    f"({_named(rival)}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
+        if t >= AMBIGUOUS_T:
+            c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
+                        f"({_named(rival)}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
+        else:
+            v, _, se = suspected_estimate(kin, rival)
+            c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, whose time skew the "
+                        f"kinematics do not rule out ({_named(rival)}: {1000 * v:.1f} ± {1000 * se:.1f} ms, "
+                        f"t = {t:.1f}), and a skew within {IMITATION_Z:g} standard errors of that imitates this term")
