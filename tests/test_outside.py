@@ -485,10 +485,11 @@ def test_a_moment_reference_shift_on_a_lateral_maneuver_is_named_by_its_two_axes
     assert f["evidence"]["rival"]["set_apart"].startswith("C_m's mean carries the mistrim")
 
 
-def independent_c172x_recording(path: Path, seed: int, sim_hz: float = 100.0, duration_s: float = 25.0) -> None:
+def independent_c172x_recording(path: Path, seed: int, sim_hz: float = 100.0, duration_s: float = 25.0,
+                                pitch_only: bool = False) -> None:
     """Fly the package's c172x with jsbsim alone (JSBSim trim at 4,000 ft and 180 ft/s, FCS
     disabled, step inputs written to the surfaces: stabilator 3-2-1-1 of 3°, aileron and rudder
-    doublets of 3°) and write ``path`` with white noise and a Gauss-Markov wander on the vanes,
+    doublets of 3°, unless ``pitch_only``) and write ``path`` with white noise and a Gauss-Markov wander on the vanes,
     reading every property after ``run()`` as a script would: JSBSim integrates its rotational
     rates by rectangular Euler, and the kinematics then put the gyros 3-7 ms off the vanes at
     ``sim_hz`` = 100 (:data:`harness.diagnosis.sensor_rules.GYROS`)."""
@@ -513,7 +514,7 @@ def independent_c172x_recording(path: Path, seed: int, sim_hz: float = 100.0, du
         edges = np.cumsum([1.0, 1.5, 1.0, 0.5, 0.5])   # 3-2-1-1 in 0.5 s units from t = 1 s
         for (a, b), sign in zip(zip(edges[:-1], edges[1:]), (1, -1, 1, -1)):
             out["de"] += sign * d if a <= t < b else 0.0
-        for s, t0 in (("da", 7.0), ("dr", 13.0)):
+        for s, t0 in (() if pitch_only else (("da", 7.0), ("dr", 13.0))):
             out[s] += d if t0 <= t < t0 + 1 else -d if t0 + 1 <= t < t0 + 2 else 0.0
         return out
 
@@ -640,3 +641,25 @@ def test_a_recording_too_short_to_diagnose_is_a_user_error(tmp_path):
     r = subprocess.run([sys.executable, "-m", "harness", "diagnose", "--model", "c172x", "--recording", str(path),
                         "--out", str(tmp_path / "out"), "--no-calibrate"], capture_output=True, text=True)
     assert r.returncode == 2 and "needs at least 4 s" in r.stderr and "internal error" not in r.stderr
+
+
+@pytest.mark.parametrize("seed, parameter, words", [
+    (1, "Cm_alphadot", "may itself be in error (skew_q"),    # a suspected q skew (t 3.1), through the column
+    (3, "Cm_alphadot", "whose time skew the kinematics do not rule out"),  # t 2.1: not suspected
+    (10, "Cm_de", "may itself be in error (skew_q"),          # a level term: the imitation is computed
+    (8, "Cm_alpha2", "integration's own drift"),
+])
+def test_a_pitch_null_at_a_100_hz_step_names_nothing(tmp_path, seed, parameter, words):
+    """The independent script's c172x pitch-only nulls (seeds 1-20) named 9 false findings at
+    the sixteenth session's start (mostly C_m,α̇ of +1.0 to +1.4, t 6-13). Where the α vane's
+    error column is in C_m's fit, a term is asked against the gyro skews the kinematics do not
+    rule out, not only those they suspect, a level term too (term_rules.withhold_ambiguous),
+    and a power of α must hold without the column's drift: 1 is left (Limits). These are
+    `none`, the term withheld for its stated reason."""
+    from harness.diagnosis.run import diagnose
+    path = tmp_path / "c172x.csv"
+    independent_c172x_recording(path, seed, pitch_only=True)
+    result = diagnose("c172x", path, tmp_path / "out", calibrate=False)
+    assert [f["effect"] for f in result["findings"]] == ["none"]
+    term = next(c for c in result["candidates"] if c["parameter"] == parameter)
+    assert abs(term["t"]) >= 5.0 and not term["selected"] and words in term["reason"]
