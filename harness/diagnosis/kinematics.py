@@ -21,8 +21,9 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
+from scipy.signal import detrend
 
-from estimators.colored_stepwise import ColoredSelection, colored_forward_selection
+from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
 from harness.diagnosis.prepare import Prepared, clean_channels, interior_slice
 from models.constants import G0_FPS2 as G0
 from models.hidden import vane_shift
@@ -388,32 +389,24 @@ def time_base_ratio(p: Prepared) -> tuple[float, float] | None:
     the time column (the φ and θ equations of the module docstring; not the heading, which a
     recording may give as magnetic or as the track: the Twin Otter's disagrees with its
     gyros by a ratio of −1.1 and −0.3 where its bank angle agrees to 1.06 and 1.00): the
-    least-squares ratio k in angle = k·∫rate dt + a + b·t (a constant and a trend per angle
-    take up its start and a gyro bias) and its standard error (white residuals); None without
-    the attitudes, or where they hardly moved. Integrated, the gyros' noise is a small random
-    walk beside the angles' excursion, where differentiated angles against the rates would
-    read the noise as a ratio under one."""
+    least-squares ratio k in angle = k·∫rate dt + a + b·t (each angle and its integral less a
+    line, :func:`scipy.signal.detrend`: a constant and a trend take up its start and a gyro
+    bias) and its colored-residual standard error (seed Eq. 40: the residual of an integral is
+    far from white); None without the attitudes, or where they hardly moved. Integrated, the
+    gyros' noise is a small random walk beside the angles' excursion, where differentiated
+    angles against the rates would read the noise as a ratio under one."""
     ch = p.raw
     if not all(c in ch for c in ("phi", "theta", "p", "q", "r")):
         return None
     P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
     pairs = [(phi, P + np.tan(th) * (Q * np.sin(phi) + R * np.cos(phi))),
              (th, Q * np.cos(phi) - R * np.sin(phi))]
-    t = np.arange(p.n) * p.dt
-    ys, xs = [], []
-    for angle, rate in pairs:
-        integral = _integral(rate, p.dt)
-        A = np.column_stack([np.ones(p.n), t])
-        ys.append(angle - A @ np.linalg.lstsq(A, angle, rcond=None)[0])   # the angle, and its integral,
-        xs.append(integral - A @ np.linalg.lstsq(A, integral, rcond=None)[0])  # each less a line
-    y, x = np.concatenate(ys), np.concatenate(xs)
-    sxx = float(x @ x)
-    if sxx <= 0.0:
+    y = np.concatenate([detrend(angle) for angle, _ in pairs])
+    x = np.concatenate([detrend(_integral(rate, p.dt)) for _, rate in pairs])
+    if float(x @ x) <= 0.0:
         return None
-    k = float(x @ y) / sxx
-    resid = y - k * x
-    se = float(np.sqrt(resid @ resid / max(y.size - 1, 1) / sxx))
-    return k, se
+    theta, se, _ = colored_fit(y, [x], ["k"], constant=False)
+    return float(theta[0]), float(se[0])
 
 
 def time_base_problem(p: Prepared) -> str:

@@ -624,16 +624,21 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
         c.details["suspicion"] = {"parameter": c.details["sensor_rival"], "t": t}
         if not isinstance(rival, str):
             c.details["sensor_rivals"] = list(rival)
-            each = "; ".join(f"{n} {1000 * e[0]:.1f} ± {1000 * e[2]:.1f} ms" for n in rival
-                             for e in [suspected_estimate(kin, n)])
-            c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, whose time skews together "
-                        f"({each}) the kinematics do not rule out, and skews within {IMITATION_Z:g} standard errors "
-                        "of them imitate this term")
-        elif t >= AMBIGUOUS_T:
-            c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, which may itself be in error "
-                        f"({_named(rival)}, kinematic t = {t:.1f}): a lagging or scaled {sensor} imitates this term")
-        else:
-            v, _, se = suspected_estimate(kin, rival)
-            c.reason = (f"entered, but not named: {c.channel} is measured with {sensor}, whose time skew the "
-                        f"kinematics do not rule out ({_named(rival)}: {1000 * v:.1f} ± {1000 * se:.1f} ms, "
-                        f"t = {t:.1f}), and a skew within {IMITATION_Z:g} standard errors of that imitates this term")
+        why = _measured_with(kin, rival, t, sensor)
+        c.reason = f"entered, but not named: {c.channel} is measured with {sensor}, {why}"
+
+
+def _measured_with(kin: KinematicResult, rival: str | tuple[str, ...], t: float, sensor: str) -> str:
+    """Why a term is withheld for an error of a sensor its axis is measured with
+    (:func:`withhold_ambiguous`): a suspected one, one not ruled out, or several together."""
+    if not isinstance(rival, str):
+        each = "; ".join(f"{n} {1000 * e[0]:.1f} ± {1000 * e[2]:.1f} ms" for n in rival
+                         for e in [suspected_estimate(kin, n)])
+        return (f"whose time skews together ({each}) the kinematics do not rule out, and skews within "
+                f"{IMITATION_Z:g} standard errors of them imitate this term")
+    if t >= AMBIGUOUS_T:
+        return (f"which may itself be in error ({_named(rival)}, kinematic t = {t:.1f}): a lagging or scaled "
+                f"{sensor} imitates this term")
+    v, _, se = suspected_estimate(kin, rival)
+    return (f"whose time skew the kinematics do not rule out ({_named(rival)}: {1000 * v:.1f} ± {1000 * se:.1f} ms, "
+            f"t = {t:.1f}), and a skew within {IMITATION_Z:g} standard errors of that imitates this term")
