@@ -212,6 +212,10 @@ def _add_diagnose(sub) -> None:
     g.add_argument("--mass", choices=("model", "recording"), default="model",
                    help="fly the model with its own mass properties (default) or with the recording's (mass, "
                         "inertia at its first sample)")
+    g.add_argument("--aero-reference", choices=("auto", "project", "xml", "cg"), default="auto",
+                   help="where the model's aerodynamic reference point is: auto (default) lets the recording choose "
+                        "for a model the project flies with it moved (the 737: on its c.g., or where JSBSim ships it), "
+                        "project, xml (where the aircraft XML puts it) or cg (on the c.g.)")
     g.add_argument("--recording", required=True, help="identification recording (.csv beside .meta.json, or .parquet)")
     g.add_argument("--validation", default=None, help="a second maneuver to validate the repaired model on")
     g.add_argument("--out", required=True, help="output folder")

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import jsbsim
@@ -12,6 +12,15 @@ from models.errors import UserError
 
 VARIANTS = ("nominal", "exact-truth", "unstable")
 MODELS = ("f16", "737", "dhc6")
+
+# Where the aerodynamic reference point is put (:func:`place_reference_point`): ``project``
+# the project's own placement (the 737's and the exact-truth variant's on the c.g., every
+# other model's where its XML puts it), ``xml`` where the XML puts it, ``cg`` on the c.g.
+AERO_REFERENCES = ("project", "xml", "cg")
+
+# Models the project flies with the aerodynamic reference point moved off the XML's place,
+# by their short names (an XML copy of the 737 with a recording's mass is "737-mass").
+MOVED_REFERENCE_MODELS = ("737", "737-mass")
 
 # The model's folder and file name in the jsbsim package (its aircraft/<name>/<name>.xml).
 PACKAGE_NAMES: dict[str, str] = {"f16": "f16", "737": "737", "dhc6": "DHC6"}
@@ -69,6 +78,12 @@ class Aircraft:
         (seed §III.C: no model-structure error). ``'unstable'``: the aerodynamic reference point moved forward
         by ``rp_shift_in``, which makes the airframe statically unstable (seed §II, last
         paragraph: equation error handles open-loop unstable aircraft flown closed loop).
+    aero_reference : str
+        Where the aerodynamic reference point is (:data:`AERO_REFERENCES`): ``'project'``
+        (default) the variant's own placement, ``'xml'`` the XML's (the 737 as JSBSim ships
+        it: 1.2 ft aft of and 4.9 ft above its c.g., so its side force rolls it and its lift
+        pitches it beyond the XML's moment constants), ``'cg'`` on the c.g. Only the nominal
+        variant takes another than ``'project'``.
     rp_shift_in : float
         Forward shift of the aerodynamic reference point for the unstable variant, inches.
         The default 8 in (5.9 % of the F-16's chord) turns Cm_alpha from -0.08 to about +0.15
@@ -79,8 +94,15 @@ class Aircraft:
     variant: str = "nominal"
     rp_shift_in: float = 8.0
     hidden: tuple = ()  # models.hidden.HiddenEffect: concealed physics for the discrepancy diagnosis
+    aero_reference: str = "project"
 
     def __post_init__(self) -> None:
+        if self.aero_reference not in AERO_REFERENCES:
+            raise AircraftError(f"unknown aerodynamic reference point {self.aero_reference!r}; "
+                                f"choose one of {AERO_REFERENCES}")
+        if self.aero_reference != "project" and self.variant != "nominal":
+            raise AircraftError(f"variant {self.variant!r} places its own aerodynamic reference point: "
+                                f"aero_reference {self.aero_reference!r} is only for the nominal variant")
         if self.model not in MODELS and not is_xml_model(self.model):
             raise AircraftError(f"unknown aircraft {self.model!r}; choose one of {MODELS} or give the path "
                              "of a JSBSim aircraft XML (<name>.xml)")
@@ -108,6 +130,7 @@ class Aircraft:
     @property
     def label(self) -> str:
         base = self.name if self.variant == "nominal" else f"{self.name}/{self.variant}"
+        base += "" if self.aero_reference == "project" else f"@rp-{self.aero_reference}"
         return base + "".join(f"+{e.effect}" for e in self.hidden)
 
 
@@ -334,12 +357,47 @@ def load_fdm(aircraft: Aircraft, dt: float, *, root: Path | None = None,
     return fdm
 
 
+def reference_on_cg(aircraft: Aircraft) -> bool:
+    """Whether ``aircraft`` flies with its aerodynamic reference point on the c.g.
+    (:attr:`Aircraft.aero_reference`; the project puts the 737's there so that its
+    derivatives are its XML's constants, shared/jsbsim-notes.md)."""
+    if aircraft.aero_reference == "project":
+        return aircraft.model == "737" or aircraft.variant == "exact-truth"
+    return aircraft.aero_reference == "cg"
+
+
+def reference_point_alternative(aircraft: Aircraft) -> Aircraft | None:
+    """``aircraft`` with its aerodynamic reference point placed the other way, for a model the
+    project flies with it moved (:data:`MOVED_REFERENCE_MODELS`: the 737 on its c.g. where
+    JSBSim ships it 1.2 ft aft and 4.9 ft above; its XML copy with a recording's mass, flown
+    as it is, then has the c.g. as the alternative); None for every other model or variant.
+    A recording made by someone else's script may have been flown either way."""
+    if aircraft.variant != "nominal" or aircraft.name not in MOVED_REFERENCE_MODELS:
+        return None
+    if reference_on_cg(aircraft):
+        return replace(aircraft, aero_reference="xml")
+    on_cg = replace(aircraft, aero_reference="project")
+    return on_cg if reference_on_cg(on_cg) else replace(aircraft, aero_reference="cg")
+
+
+def placement(aircraft: Aircraft) -> str:
+    """``aircraft``'s aerodynamic reference point as an explicit :attr:`Aircraft.aero_reference`
+    (``'cg'`` or ``'xml'``): the same placement for another :class:`Aircraft` of the same XML
+    (a calibration's copy with a recording's mass)."""
+    return "cg" if reference_on_cg(aircraft) else "xml"
+
+
+def reference_point_text(aircraft: Aircraft) -> str:
+    """Where ``aircraft``'s aerodynamic reference point is, in words."""
+    return "on the c.g." if reference_on_cg(aircraft) else "at the XML's AERORP"
+
+
 def place_reference_point(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> bool:
     """Apply the variant's aerodynamic reference point (needs the mass model: after run_ic).
 
     Returns whether it moved (the caller then re-initialises)."""
-    moved = aircraft.model == "737" or aircraft.variant in ("exact-truth", "unstable")
-    if aircraft.model == "737" or aircraft.variant == "exact-truth":
+    moved = reference_on_cg(aircraft) or aircraft.variant == "unstable"
+    if reference_on_cg(aircraft):
         # Moments about the c.g.: put the aerodynamic reference point on it.
         for ax in "xyz":
             fdm[f"metrics/aero-rp-{ax}-in"] = fdm[f"inertia/cg-{ax}-in"]

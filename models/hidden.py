@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -313,10 +313,10 @@ def hidden_root(aircraft, condition, refs: dict[str, float] | None = None):
     ``condition`` unless ``refs`` or an effect's ``reference`` gives them, so an added
     α-polynomial vanishes, with its slope, at the trim point.
     """
-    from models.aircraft import Aircraft, load_fdm, model_xml, nominal_tree
+    from models.aircraft import load_fdm, model_xml, nominal_tree
     from models.jsbsim_root import cached_root
     from models.trim import trim
-    nominal = Aircraft(aircraft.model, "nominal")
+    nominal = replace(aircraft, variant="nominal", hidden=())
     tp = trim(load_fdm(nominal, 1 / 120), nominal, condition)
     base = {"alpha": tp.alpha_rad, "dV": tp.V_fps, "de": tp.de_rad, "da": tp.da_rad, "dr": tp.dr_rad}
     base.update(refs or {})

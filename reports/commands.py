@@ -78,7 +78,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from harness.diagnosis.run import diagnose
     from reports.diagnosis_report import write_diagnosis_report
     result = diagnose(args.model, args.recording, args.out, args.validation, mass=args.mass,
-                      calibrate=getattr(args, "calibrate", True), calibrate_workers=getattr(args, "workers", 2))
+                      calibrate=getattr(args, "calibrate", True), calibrate_workers=getattr(args, "workers", 2),
+                      aero_reference=getattr(args, "aero_reference", "auto"))
     html = write_diagnosis_report(Path(args.out), getattr(args, "workers", 2))
     for f in result["findings"]:
         if f["effect"] == "none":

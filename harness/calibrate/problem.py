@@ -42,18 +42,20 @@ class Base:
     source: str
     model: str
     name: str
+    aero_reference: str = "project"  # models.aircraft.Aircraft.aero_reference
 
     @property
     def aircraft(self) -> Aircraft:
-        return Aircraft(self.model)
+        return Aircraft(self.model, aero_reference=self.aero_reference)
 
     def tree(self) -> ET.ElementTree:
         return ET.ElementTree(ET.fromstring(self.xml))
 
 
-def base_aircraft(model: str, mass: MassProperties | None = None) -> Base:
+def base_aircraft(model: str, mass: MassProperties | None = None, aero_reference: str = "project") -> Base:
     """The :class:`Base` of a project model (``f16``, ``737``, ``dhc6``) or an XML path, with
-    ``mass`` written into it when given (:func:`models.mass.set_mass_properties`).
+    ``mass`` written into it when given (:func:`models.mass.set_mass_properties`), its
+    aerodynamic reference point placed by ``aero_reference`` (:data:`models.aircraft.AERO_REFERENCES`).
 
     Raises
     ------
@@ -64,7 +66,8 @@ def base_aircraft(model: str, mass: MassProperties | None = None) -> Base:
     if model not in MODELS and not is_xml_model(model):
         raise CalibrationError(f"--model {given!r} is not " + MODEL_ARGUMENT_HELP.format(models=MODELS))
     try:
-        aircraft = Aircraft(str(Path(model).resolve()) if is_xml_model(model) else model)
+        aircraft = Aircraft(str(Path(model).resolve()) if is_xml_model(model) else model,
+                            aero_reference=aero_reference)
         aircraft.surfaces  # noqa: B018 - names a surface the XML lacks
         tree = nominal_tree(aircraft.model)
         if mass is not None:
@@ -72,7 +75,7 @@ def base_aircraft(model: str, mass: MassProperties | None = None) -> Base:
     except (ValueError, OSError, ET.ParseError) as exc:
         raise CalibrationError(f"--model {model}: {exc}") from exc
     return Base(xml=ET.tostring(tree.getroot()), source=str(model_xml(aircraft.model)), model=aircraft.model,
-                name=f"{aircraft.name}-calibration")
+                name=f"{aircraft.name}-calibration", aero_reference=aero_reference)
 
 
 @dataclass(frozen=True)

@@ -155,7 +155,7 @@ def _series(maneuvers: list[Maneuver], smooth: list[np.ndarray], before, after) 
 
 def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str | Adjustment], *,
               validation=None, outputs: Sequence[str] | None = None, workers: int = 2, mass: str = "model",
-              max_iterations: int = 20, hold: str = "linear") -> CalibrationResult:
+              max_iterations: int = 20, hold: str = "linear", aero_reference: str = "project") -> CalibrationResult:
     """Calibrate ``aircraft`` (``f16``, ``737``, ``dhc6``, an XML path, or a :class:`Base`) to
     ``recordings`` (paths or :class:`~maneuvers.recording.Recording`, one or several).
 
@@ -174,6 +174,8 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
     hold : how the recorded surfaces are replayed between samples: ``'linear'`` (a surface that
         moves continuously: flight data) or ``'sample'`` (each sample held until the next: a
         stepped input sampled at its edges, as simulated recordings are).
+    aero_reference : where a model given by name has its aerodynamic reference point
+        (:data:`models.aircraft.AERO_REFERENCES`; the diagnosis passes the placement it chose).
 
     Raises
     ------
@@ -207,7 +209,7 @@ def calibrate(aircraft: str | Base, recordings, parameters: str | Sequence[str |
                 mp = MassProperties.from_mapping(recs[0].mass_at(0))
             except (KeyError, ValueError) as exc:
                 raise CalibrationError(f"--mass recording: {exc}") from exc
-        base = base_aircraft(str(aircraft), mp)
+        base = base_aircraft(str(aircraft), mp, aero_reference)
     check(base, adjustments)
     ident = [maneuver(r, tuple(outputs) if outputs else None, hold) for r in recs]
     outs = ident[0].outputs

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -22,7 +23,7 @@ from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
 from harness.diagnosis.validation import after_mismatch
 from harness.diagnosis.verdict import check_time_base
 from harness.executors import LocalPool
-from models.aircraft import Aircraft
+from models.aircraft import Aircraft, placement, reference_point_alternative
 from models.constants import SURFACES
 from models.flight import FlightError
 from models.hidden import HiddenEffect, hidden_root
@@ -158,7 +159,7 @@ def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect
     after = before
     winds = _turbulence_winds(p, analysis) if any(f.effect == "turbulence" for f in findings or []) else None
     if (added or winds is not None) and before.failed is None:
-        augmented, start = Aircraft(aircraft.model, hidden=added), _true_start(p, added)
+        augmented, start = replace(aircraft, hidden=added), _true_start(p, added)
         after = _fitted_replay(p, lambda surf: replay(augmented, start, p.t, surf, wind_ned_fps=winds, refs=refs)[0])
     before_failed, diverged = before.failed, after.failed
     a = analysis
@@ -268,10 +269,12 @@ def refine_in_the_loop(model: str, recs: dict, aircraft: Aircraft, mass: str, wo
     matched = refine.matched_outputs(terms, recs["identification"])
     block = {"used": False, "hold": hold, "hold_assumption": hold_reason, "workers": workers,
              "matched_outputs": list(matched)}
+    # the calibration's copy is placed as the diagnosis's aircraft (reference_point.py)
+    placed = placement(aircraft) if reference_point_alternative(aircraft) else "project"
     try:
         cal = calibrate_in_loop(model, [recs["identification"]], refine.parameter_spec(terms),
                                 validation=[recs["validation"]] if "validation" in recs else None, workers=workers,
-                                mass=mass, hold=hold, outputs=matched)
+                                mass=mass, hold=hold, outputs=matched, aero_reference=placed)
     except (CalibrationError, FlightError, TrimError, RuntimeError, ValueError, OSError) as exc:
         # the last step never takes the diagnosis down: the equation-error sizes stand
         return block | {"reason": f"the calibration could not run: {type(exc).__name__}: {exc}"}, modelled, added, flown
@@ -386,7 +389,7 @@ def write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ..
     if not any(not e.effect.startswith("sensor_") for e in added):
         return {"base": aircraft.model, "augmented_xml": None, "terms": terms,
                 "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
-    root, name = hidden_root(Aircraft(aircraft.model, hidden=added), ic.condition(), refs)
+    root, name = hidden_root(replace(aircraft, hidden=added), ic.condition(), refs)
     src = root / "aircraft" / name / f"{name}.xml"
     target = dest / f"{aircraft.name}-diagnosed.xml"
     write_atomic(target, lambda fh: fh.write(src.read_bytes()))

@@ -6,6 +6,7 @@ import contextlib
 import json
 import time
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 
 from harness.atomic import jsonable, write_atomic, write_text_atomic
@@ -16,6 +17,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.prepare import instruments_at_cg, prepare
+from harness.diagnosis.reference_point import choose_reference_point
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
 from harness.diagnosis.validation import undecided, validation_check
 from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, check_time_base,
@@ -23,7 +25,8 @@ from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_
                                        none_finding, not_checked, remaining_mismatch)
 from harness.executors import LocalPool
 from harness.recording_io import read_recording
-from models.aircraft import MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument, nominal_root
+from models.aircraft import (AERO_REFERENCES, MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument,
+                             nominal_root, reference_point_alternative)
 from models.mass import MassProperties, mass_root
 from models.replay import initial_condition
 
@@ -102,7 +105,8 @@ def incomplete_marker(out: Path):
 
 
 def diagnose(model: str, recording: str | Path, out: str | Path, validation: str | Path | None = None, *,
-             mass: str = "model", calibrate: bool = True, calibrate_workers: int = 2) -> dict:
+             mass: str = "model", calibrate: bool = True, calibrate_workers: int = 2,
+             aero_reference: str = "auto") -> dict:
     """Diagnose ``recording`` against ``model``; write ``out``; return findings.json's content.
 
     ``mass='recording'`` flies the model with the recording's mass and inertia
@@ -110,7 +114,10 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
     kept aerodynamic and delay terms with JSBSim in the loop as the last step
     (:mod:`harness.diagnosis.refine`; ``calibrate_workers`` processes fly its flights, 1: in
     this process); the calibrated sizes are kept only when they fit at least as well, and
-    findings.json's ``calibration`` block says which and why.
+    findings.json's ``calibration`` block says which and why. ``aero_reference`` places the
+    model's aerodynamic reference point (:data:`models.aircraft.AERO_REFERENCES`); ``'auto'``
+    lets the recording choose for a model the project flies with it moved (the 737:
+    :mod:`harness.diagnosis.reference_point`), findings.json's ``assumptions`` saying which.
 
     Raises
     ------
@@ -121,19 +128,23 @@ def diagnose(model: str, recording: str | Path, out: str | Path, validation: str
         # a second process takes the validation maneuver's share (analysis, replays) meanwhile
         pool = stack.enter_context(LocalPool(1)) if validation is not None and calibrate_workers > 1 else None
         return _diagnose(model, recording, folder, validation, mass=mass, calibrate=calibrate,
-                         workers=calibrate_workers, pool=pool)
+                         workers=calibrate_workers, pool=pool, aero_reference=aero_reference)
 
 
 def _loaded(model: str, recording: str | Path, validation: str | Path | None,
-            mass: str) -> tuple[Aircraft, dict]:
-    """The aircraft (with the recording's mass when asked) and the recordings, instruments at
-    the c.g."""
+            mass: str, aero_reference: str = "auto") -> tuple[Aircraft, dict]:
+    """The aircraft (with the recording's mass when asked, its aerodynamic reference point
+    where given) and the recordings, instruments at the c.g."""
+    if aero_reference != "auto" and aero_reference not in AERO_REFERENCES:
+        raise DiagnosisError(f"aero_reference must be 'auto' or one of {AERO_REFERENCES}, not {aero_reference!r}")
     aircraft = _aircraft(model)
     rec = instruments_at_cg(read_recording(recording))
     if mass == "recording":
         aircraft = _with_recorded_mass(aircraft, rec)
     elif mass != "model":
         raise DiagnosisError(f"mass must be 'model' or 'recording', not {mass!r}")
+    if aero_reference != "auto":
+        aircraft = replace(aircraft, aero_reference=aero_reference)
     recs = {"identification": rec}
     if validation is not None:
         recs["validation"] = instruments_at_cg(read_recording(validation))
@@ -200,15 +211,24 @@ def _write_series(out: Path, series: dict) -> None:
 
 
 def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Path | None, *, mass: str,
-              calibrate: bool = True, workers: int = 2, pool: LocalPool | None = None) -> dict:
+              calibrate: bool = True, workers: int = 2, pool: LocalPool | None = None,
+              aero_reference: str = "auto") -> dict:
     t0 = time.perf_counter()
-    aircraft, recs = _loaded(model, recording, validation, mass)
+    aircraft, recs = _loaded(model, recording, validation, mass, aero_reference)
     pending = None
-    if validation is not None and pool is not None:
+    # the validation maneuver is analysed in a second process meanwhile, with the aircraft
+    # placed as the identification says where it can be placed two ways
+    choosing = aero_reference == "auto" and reference_point_alternative(aircraft) is not None
+    if validation is not None and pool is not None and not choosing:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     p = prepare(recs["identification"], "identification")
     check_time_base(p)
     ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude)
+    reference = choose_reference_point(p, aircraft, ic, aero_reference)
+    if reference is not None:
+        aircraft = reference.aircraft
+    if validation is not None and pool is not None and choosing:
+        pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     a = analyse(p, aircraft, ic)
     check_model_represents(a, model)
     befores = {"identification": replay_before(p, aircraft, a)}
@@ -250,7 +270,8 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         "located": located,
         "not_confirmed": [finding_dict(f, {}, {}, checks.get(id(f))) for f in unconfirmed],
         "calibration": calibration,
-        "assumptions": assumptions(a, aircraft, mass) + calibration_assumptions(calibration),
+        "assumptions": (assumptions(a, aircraft, mass) + ([reference.assumption()] if reference else [])
+                        + calibration_assumptions(calibration)),
         "not_checked": not_checked(a, validation is not None),
         "detection_limits": detection_limits(a),
         "noise": {c: {"std": p.noise_std[c], "cutoff_hz": p.cutoff_hz[c]} for c in p.noise_std},
