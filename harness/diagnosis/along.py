@@ -12,7 +12,8 @@ import numpy as np
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles
-from harness.diagnosis.prepare import COEFFICIENTS, Prepared, clean_channels, interior_slice, measured_coefficients
+from harness.diagnosis.prepare import (COEFFICIENTS, DRIVEN_BY, Prepared, clean_channels, interior_slice,
+                                      measured_coefficients)
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import AeroAlong, InitialCondition, aero_along
@@ -60,9 +61,12 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: 
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven and k not in p.moved and not (vanes and k in ("alpha", "beta")):
             states[k] = np.full(p.n, p.start[k])
-    if inertial_beta(p) and not (vane_beta or vanes):
+    inertial = [] if (vane_beta or vanes) else (["beta"] if inertial_beta(p) else []) + undriven_inertial(p)
+    if inertial:
         src = inertial_from or p
-        states["beta"] = p.filt(inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)["beta"])
+        angles = inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)
+        for k in inertial:
+            states[k] = p.filt(angles[k])
     surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
@@ -98,6 +102,21 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
 
 # What the inertial sideslip is integrated from (kinematics.inertial_angles).
 INERTIAL_CHANNELS = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ay", "az")
+
+
+def undriven_inertial(p: Prepared) -> list[str]:
+    """The vane angles the maneuver's own input moved but not clear of the vane's noise
+    (their group's surface moved, :data:`prepare.DRIVEN_BY`, and they are neither driven nor
+    moved): the model is evaluated along their inertial reconstruction rather than held at
+    their start. Held, their true motion stays in the mismatch and reads as whatever column
+    follows it: an F-16 lateral multisine at 40 Hz with twice the noise moved β 0.27° (the
+    vane's noise 0.2° white and 0.2° of wander), and the C_Y the held β left out, C_Y,β·β,
+    was read as an accelerometer 11 ft aft (t −10, two of four seeds). Inertially the angle
+    carries integrated accelerometer noise, not the vane's; no term is built on it."""
+    if not all(c in p.raw for c in INERTIAL_CHANNELS):
+        return []
+    return [k for k in ("alpha", "beta") if k not in p.driven and k not in p.moved
+            and any(s in p.driven for s in DRIVEN_BY[k])]
 
 
 def inertial_beta(p: Prepared) -> bool:

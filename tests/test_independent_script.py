@@ -1,0 +1,48 @@
+"""The diagnosis on recordings from a jsbsim-only script (tests/independent_script.py:
+multisines through a measured actuator, other sample rates, noise levels and unit
+conventions) — the kind of recording an evaluator's own script makes (issue 12)."""
+from __future__ import annotations
+
+import pytest
+
+from harness.diagnosis.run import diagnose
+from independent_script import fly
+
+
+def _found(result):
+    return [(f["parameter"], round(f["estimate"], 4)) for f in result["findings"] if f["effect"] != "none"]
+
+
+def _placement(result):
+    return next((a["stood_in_by"] for a in result["assumptions"] if a["item"] == "aerodynamic reference point"), "")
+
+
+@pytest.mark.parametrize("seed", [31, 32])
+def test_a_sideslip_the_vane_cannot_resolve_is_followed_inertially(tmp_path, seed):
+    """An F-16 lateral multisine at 40 Hz with twice the noise moves β about 0.27°, under the
+    vane's noise: held at its start, the C_Y it left out read as an accelerometer 10-11 ft aft
+    (t −10) on both seeds; evaluated along the inertial β, nothing is found."""
+    rec = fly(tmp_path / "lat.csv", "f16", 15000.0, 600.0, seed, 40.0, "ms_lat", noise=2.0)
+    result = diagnose("f16", rec, tmp_path / "out", calibrate=False)
+    assert _found(result) == []
+
+
+def test_a_pitch_multisine_at_25_hz_in_metric_units_gives_none(tmp_path):
+    """A c172x pitch multisine at 25 Hz, twice the noise, metric units: α moves under the vane's
+    noise; held, the C_m and C_Z it left out read as C_m,δe, C_Z,δe, C_m,q̂ and C_Z,q̂."""
+    rec = fly(tmp_path / "pitch.csv", "c172x", 4000.0, 180.0, 5, 25.0, "ms_pitch", units="metric", noise=2.0)
+    result = diagnose("c172x", rec, tmp_path / "out", calibrate=False)
+    assert _found(result) == []
+
+
+@pytest.mark.parametrize("kind, xml_placement", [("ms_pitch", True), ("ms_lat", True), ("ms_lat", False)])
+def test_a_737_flown_by_another_script_gives_none_either_placement(tmp_path, kind, xml_placement):
+    """The 737 as JSBSim ships it (its reference point 1.2 ft aft of and 4.9 ft above the
+    c.g.) drew a moment-reference offset (pitch) or a C_l,β (lateral) against the project's
+    c.g. placement; placed as the recording says, identification and doublet validation give
+    none, and the assumption names the placement."""
+    rec = fly(tmp_path / "id.csv", "737", 25000.0, 700.0, 8, 50.0, kind, noise=1.0, xml_placement=xml_placement)
+    val = fly(tmp_path / "val.csv", "737", 25000.0, 700.0, 508, 50.0, "dbl3", noise=1.0, xml_placement=xml_placement)
+    result = diagnose("737", rec, tmp_path / "out", val, calibrate=False)
+    assert _found(result) == []
+    assert _placement(result).startswith("at the XML's AERORP" if xml_placement else "on the c.g., as the recording")
