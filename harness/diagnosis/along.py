@@ -13,7 +13,7 @@ from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles
 from harness.diagnosis.prepare import (COEFFICIENTS, DRIVEN_BY, Prepared, clean_channels, interior_slice,
-                                      measured_coefficients)
+                                       measured_coefficients)
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import AeroAlong, InitialCondition, aero_along
