@@ -44,13 +44,14 @@ def inputs(kind: str, amplitude_rad: float, duration_s: float, rng: np.random.Ge
 
 def fly(path: Path, model: str, h_ft: float, V_fps: float, seed: int, out_hz: float, kind: str,
         units: str = "si", noise: float = 1.0, duration_s: float = 28.0, amplitude_deg: float = 2.0,
-        xml_placement: bool = True) -> Path:
+        xml_placement: bool = True, root: str | None = None) -> Path:
     """Fly ``model`` and write ``path`` (CSV) beside its ``.meta.json``; the 737's aerodynamic
     reference point stays where its XML puts it unless ``xml_placement`` is False (then it is
-    moved onto the c.g., as shared/jsbsim-notes.md suggests for exact truth)."""
+    moved onto the c.g., as shared/jsbsim-notes.md suggests for exact truth); ``root`` is a
+    JSBSim root folder holding a modified copy of the aircraft (default: the package's)."""
     import jsbsim
     sim_hz = 200.0 if 100.0 % out_hz else 100.0
-    fdm = jsbsim.FGFDMExec(None)
+    fdm = jsbsim.FGFDMExec(root)
     fdm.set_debug_level(0)
     assert fdm.load_model(model)
     fdm.set_dt(1.0 / sim_hz)

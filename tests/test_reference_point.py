@@ -68,7 +68,9 @@ def test_a_moment_change_splits_exactly_into_its_arms_along_the_forces():
 def test_a_group_tells_a_placement_only_when_it_rules_the_other_out():
     assert told(0.98, 0.04) == 1.0 and told(0.01, 0.03) == 0.0
     assert told(0.5, 0.2) is None  # near neither
-    assert told(1.48, 0.37) is None  # 1.3 s.e. from one, but only 4 from zero
+    assert told(1.48, 0.37) is None  # nearer one, but only 4 s.e. from zero
+    # a concealed effect on the same parts moves k off its placement: the nearer is told
+    assert told(1.55, 0.03) == 1.0 and told(0.78, 0.04) == 1.0 and told(-0.76, 0.02) == 0.0
     k, se = combined_ratio({"Cl/CY": (1.0, 0.1), "Cm/CX": (0.0, 0.1), "Cm/CZ": (9.0, 0.01)}, ("Cl/CY", "Cm/CX"))
     assert k == pytest.approx(0.5) and se == pytest.approx(0.1 / np.sqrt(2))
     assert combined_ratio({"Cm/CZ": (1.0, 0.1)}, ("Cl/CY",)) is None
@@ -126,3 +128,36 @@ def test_an_unknown_placement_is_refused(tmp_path):
     path = _recording(tmp_path, Aircraft("737"), stabilator_2112(), duration_s=8.0)
     with pytest.raises(DiagnosisError, match="aero_reference must be 'auto' or one of"):
         diagnose("737", path, tmp_path / "out", calibrate=False, aero_reference="nose")
+
+
+def test_a_stock_737_with_its_cl_beta_changed_is_sized_against_the_stock_placement(tmp_path):
+    """The evaluator's way of concealing a coefficient error: the constant in a copy of the
+    737's XML (C_l,β −0.09 → −0.12). Its roll moves C_l's part along C_Y too (k ≈ 1.55), the
+    nearer placement is the XML's, and the change is sized against it (−0.03)."""
+    import os
+    import shutil
+
+    import jsbsim
+
+    from independent_script import fly
+
+    package = os.path.dirname(jsbsim.__file__)
+    root = tmp_path / "root"
+    (root / "aircraft").mkdir(parents=True)
+    for d in ("engine", "systems"):
+        os.symlink(os.path.join(package, d), root / d)
+    shutil.copytree(os.path.join(package, "aircraft", "737"), root / "aircraft" / "737")
+    xml = root / "aircraft" / "737" / "737.xml"
+    text = xml.read_text()
+    start = text.index('<function name="aero/coefficient/Clb">')
+    end = text.index("</function>", start)
+    xml.write_text(text[:start] + text[start:end].replace("<value>-0.09</value>", "<value>-0.12</value>")
+                   + text[end:])
+    rec = fly(tmp_path / "id.csv", "737", 25000.0, 700.0, 11, 50.0, "ms_lat", root=str(root))
+    val = fly(tmp_path / "val.csv", "737", 25000.0, 700.0, 511, 50.0, "dbl3", root=str(root))
+    result = diagnose("737", rec, tmp_path / "out", val, calibrate=False)
+    assert _placement(result).startswith("at the XML's AERORP")
+    [finding] = result["findings"]
+    assert finding["parameter"] == "Cl_beta"
+    model_value = float(finding["explanation"].split("the model has ")[1].split(" over")[0])
+    assert finding["estimate"] - model_value == pytest.approx(-0.03, rel=0.25)

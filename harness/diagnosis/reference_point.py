@@ -31,12 +31,17 @@ part. A c.g. that is simply elsewhere (``cg_offset``, effects.md: along x) moves
 of the arm's x (C_m's along C_Z, C_n's along C_Y) and no other: the placement is read from
 C_l's parts (along C_Y: the arm's z; and the arm's y parts) where they tell, and only where
 those do not (a pitch maneuver) from each moment's whole change, ``mismatch_c = k·Σ_j
-part_j + a + b·t``, which then takes no c.g. offset to be there. C_m's part along C_X (the
+part_j + a + b·t``, which a c.g. offset moves as well (below). C_m's part along C_X (the
 arm's z too) is left to the whole change: on a pitch maneuver C_X moves with C_Z, and the
 two parts' joint fit split the mismatch's other structure between them (k −0.6 to −3.4 on a
 stock 737's pitch recordings whose whole change said 0.9-1.0). Each group's k are combined
-by inverse variance; a group tells when one placement lies within :data:`ACCEPT_Z` standard
-errors of its k and the other beyond :data:`REFERENCE_Z`.
+by inverse variance; a group tells the placement nearer its k when the other lies beyond
+:data:`REFERENCE_Z` standard errors. A concealed effect that moves the same parts (a C_m,α or
+c.g. change on a pitch maneuver, a C_l,β change) moves k off the placement it was flown with,
+and is then sized against the nearer placement: against the one it was flown with while it
+moves k less than half the way. Asked to lie within 3 s.e. of its placement as well, a stock
+737 with a 1 ft c.g. offset (k 1.6) was read against the c.g. placement, its offset then
+2.2 ft.
 """
 from __future__ import annotations
 
@@ -53,11 +58,9 @@ from models.constants import G0_FPS2
 from models.replay import InitialCondition
 
 REFERENCE_Z = 5.0
-"""Standard errors a group's k must lie from a placement to rule it out (the sensor tests'
-entry t of the diagnosis)."""
+"""Standard errors a group's k must lie from a placement to rule it out (the entry t of the
+diagnosis's sensor tests)."""
 
-ACCEPT_Z = 3.0
-"""Standard errors within which a group's k must lie of the placement it tells."""
 
 # Parts by the component of the arm between the placements they carry (module docstring): a
 # c.g. offset along x moves "Cm/CZ" and "Cn/CY" only; "<moment>/all" is the whole change.
@@ -170,12 +173,10 @@ def combined_ratio(ratios: dict[str, tuple[float, float]], names: tuple[str, ...
 
 
 def told(k: float, se: float) -> float | None:
-    """The placement (0 as placed, 1 the other) a group's k tells, or None (:data:`ACCEPT_Z`,
-    :data:`REFERENCE_Z`)."""
-    for placed, other in ((0.0, 1.0), (1.0, 0.0)):
-        if abs(k - placed) <= ACCEPT_Z * se and abs(k - other) >= REFERENCE_Z * se:
-            return placed
-    return None
+    """The placement (0 as placed, 1 the other) a group's k tells: the nearer, when the other
+    lies at least :data:`REFERENCE_Z` standard errors away; else None."""
+    nearer, other = (0.0, 1.0) if abs(k) <= abs(k - 1.0) else (1.0, 0.0)
+    return nearer if abs(k - other) >= REFERENCE_Z * se else None
 
 
 def choose_reference_point(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
