@@ -32,6 +32,19 @@ def corrected_recording(p: Prepared, kin: KinematicResult, values: dict[str, flo
     return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
 
 
+def rate_derivatives_advanced(p: Prepared, tau: float) -> Prepared:
+    """The recording with the derivatives of its rates (ṗ, q̇, ṙ, from which the measured
+    moment coefficients are built) advanced by ``tau`` seconds: what they would be had they
+    not lagged the moments by ``tau``. A simulation that integrates the rates by rectangular
+    Euler (JSBSim's default), x[k+1] = x[k] + h·ẋ[k], records rates whose central difference
+    at k is the mean of ẋ[k−1] and ẋ[k]: it lags the moments of step k by h/2."""
+    deriv = dict(p.deriv)
+    for g in ("p", "q", "r"):
+        if g in deriv:
+            deriv[g] = np.interp(p.t + tau, p.t, deriv[g])
+    return replace(p, deriv=deriv)
+
+
 def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: bool = False,
                  vanes: bool = False) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """The states and surfaces the model is evaluated along.

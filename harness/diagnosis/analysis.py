@@ -22,6 +22,7 @@ from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offse
 from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, imitation, note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
+                                          euler_lag_estimate,
                                           withhold_explained_by_cg, withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane, withhold_rivals)
@@ -91,7 +92,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                     measured)
     note_untested_coupling(cands, p)
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
-    withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0), column_sensors)
+    withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0), column_sensors,
+                       euler_lag_estimate(p, kin))
     if turbulent:
         withhold_in_turbulence(cands)
     else:

@@ -10,7 +10,8 @@ from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.along import INERTIAL_CHANNELS, corrected_recording, inertial_beta, interior, model_along
+from harness.diagnosis.along import (INERTIAL_CHANNELS, corrected_recording, inertial_beta, interior, model_along,
+                                     rate_derivatives_advanced)
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import turbulence_test
 from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
@@ -439,6 +440,34 @@ def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
 IMITATION_Z = 3.0
 IMITATION_SHARE = 0.5
 
+# The rival a simulation's integration step makes (:func:`euler_lag_estimate`).
+EULER_LAG = "euler_lag"
+MOMENT_AXES = ("Cl", "Cm", "Cn")
+
+
+def euler_lag_estimate(p: Prepared, kin: KinematicResult) -> tuple[float, float, float] | None:
+    """(τ, |t|, standard error) of the lag of the rates' derivatives behind the moments that a
+    simulation integrating rates and attitude by rectangular Euler leaves in its recording,
+    or None when the kinematics do not show one.
+
+    With x[k+1] = x[k] + h·ẋ[k] (JSBSim's default for the rotational rates and the attitude),
+    the central difference of the attitude at k lags the gyros by h/2, so the kinematics read
+    the rate gyros as *leading* by h/2 (a negative common skew, :data:`GYRO_UNIT`), and the
+    central difference of the rates, from which ṗ, q̇, ṙ and the moment coefficients are
+    built, lags the moments by the same h/2. Suspected when that skew is negative at
+    |t| >= :data:`AMBIGUOUS_T` and no longer than half the sample interval (a simulation step
+    no longer than the recording's) allows, within :data:`IMITATION_Z` standard errors. A
+    gyro skew cannot stand for it: shifting the rates moves their derivatives the other way
+    (an independent c172x script at 100 Hz, noise-free: the common skew −5 ms, t 360, whose
+    own correction imitated −1.0 of a C_m,α̇ change of +1.66)."""
+    unit = suspected_estimate(kin, GYRO_UNIT)
+    if unit is None or unit[0] >= 0 or unit[1] < AMBIGUOUS_T:
+        return None
+    tau, t, se = -unit[0], unit[1], unit[2]
+    if tau - IMITATION_Z * se > p.dt / 2:
+        return None
+    return tau, t, se
+
 
 def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
               mismatch: dict[str, np.ndarray], step: StepwiseFits, slope_of=None, V0: float | None = None):
@@ -472,14 +501,17 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
     def part(c: Candidate, name: str) -> tuple[float, float] | None:
         """(centre, half-width) of what error ``name`` imitates of ``c``'s change, in its
         direction: per_v·v and IMITATION_Z·|per_v|·σ."""
-        found = suspected_estimate(kin, name)
+        found = euler_lag_estimate(p, kin) if name == EULER_LAG else suspected_estimate(kin, name)
         sel, by_key = step.selections.get(c.channel, (None, {}))
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
         change = c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
         if found is None or key is None or not found[0] or not change:
             return None
         v, t, _ = found
-        corrected = corrected_recording(p, kin, {m: v for m in unit_members(kin, name)})
+        if name == EULER_LAG:
+            corrected = rate_derivatives_advanced(p, v)
+        else:
+            corrected = corrected_recording(p, kin, {m: v for m in unit_members(kin, name)})
         changed = model_along(corrected, aircraft, ic, inertial_from=p).mismatch()
         cols = [by_key[key].column[inner]] + [by_key[k].column[inner] for k in sel.names if k != key and k in by_key]
         nuisances = step.nuisances.get(c.channel, {})
@@ -518,11 +550,14 @@ def _named(rival: str | tuple[str, ...]) -> str:
     """A suspicion as the reasons name it (several errors at once: each, together)."""
     if not isinstance(rival, str):
         return " and ".join(_named(r) for r in rival) + " together"
+    if rival == EULER_LAG:
+        return "the rates' derivatives lagging the moments (a simulation's rectangular-Euler step)"
     return f"{rival}, the rate gyros' common time skew" if rival == GYRO_UNIT else rival
 
 
 def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None,
-                       column_sensors: dict[str, tuple[str, ...]] | None = None) -> None:
+                       column_sensors: dict[str, tuple[str, ...]] | None = None,
+                       euler_lag: tuple[float, float, float] | None = None) -> None:
     """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
     channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
     kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
@@ -542,7 +577,12 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     script's twenty c172x pitch nulls at 100 Hz named 9 false findings at the sixteenth
     session's start, 3 with suspected skews alone, 1 so. Asked on every axis, not only where
     the column is, it withheld six true F-16 and DHC-6 findings of the outside sweep (C_m,α̇
-    −3, C_m,q̂ −6, C_n,r̂ −0.3, C_l,p̂ −0.1), whose skews the kinematics bound loosely."""
+    −3, C_m,q̂ −6, C_n,r̂ −0.3, C_l,p̂ −0.1), whose skews the kinematics bound loosely.
+
+    ``euler_lag`` (:func:`euler_lag_estimate`), when the kinematics show it, is asked of every
+    rate-shaped moment term (C_m,α̇ and the rate derivatives of C_l, C_m, C_n) the same way:
+    withheld when the rates' derivatives lagging the moments by τ, within
+    :data:`IMITATION_Z` standard errors, imitate half its change."""
 
     asked: set[tuple[int, str]] = set()  # (term, rival) found not to explain it
 
@@ -626,6 +666,22 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             c.details["sensor_rivals"] = list(rival)
         why = _measured_with(kin, rival, t, sensor)
         c.reason = f"entered, but not named: {c.channel} is measured with {sensor}, {why}"
+    if euler_lag is None:
+        return
+    for c in cands:  # a simulation's integration step: the moments lead the rates' derivatives
+        rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
+        if not (c.selected and c.channel in MOMENT_AXES and c.test.startswith("stepwise")
+                and (c.effect == "unsteady_alphadot" or rate_term)):
+            continue
+        if explains(c, EULER_LAG, euler_lag[1]):
+            tau, t, se = euler_lag
+            c.selected = False
+            c.details["sensor_rival"] = EULER_LAG
+            c.details["euler_lag_s"] = [tau, se]
+            c.reason = (f"entered, but not named: the kinematics read the rate gyros as leading the attitude by "
+                        f"{1000 * tau:.1f} ± {1000 * se:.1f} ms (t = {t:.1f}), as a simulation integrating by "
+                        f"rectangular Euler records them; the rates' derivatives, from which {c.channel} is built, "
+                        "then lag the moments by as much, which imitates this term")
 
 
 def _measured_with(kin: KinematicResult, rival: str | tuple[str, ...], t: float, sensor: str) -> str:
