@@ -19,10 +19,9 @@ from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_par
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns)
-from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, imitation, note_untested_coupling,
+from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
-                                          euler_lag_estimate,
                                           withhold_explained_by_cg, withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane, withhold_rivals)

@@ -546,6 +546,13 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
 VANE_COLUMN_SENSORS = ("az",)
 
 
+def _lag_shaped(c: Candidate) -> bool:
+    """Whether term ``c`` follows its coefficient's rate of change (C_m,α̇ or a rate
+    derivative), the shape a lag imitates, rather than its level."""
+    rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
+    return c.effect == "unsteady_alphadot" or rate_term
+
+
 def _named(rival: str | tuple[str, ...]) -> str:
     """A suspicion as the reasons name it (several errors at once: each, together)."""
     if not isinstance(rival, str):
@@ -635,9 +642,8 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
                         f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
     for c in cands:  # the sensors the coefficient itself is measured with
         sensors = (DEPENDENT_SENSOR.get(c.channel or ""),) + (column_sensors or {}).get(c.channel or "", ())
-        rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
         # a lag imitates terms that follow the coefficient's rate of change, not its level
-        lag_shaped = c.effect == "unsteady_alphadot" or rate_term
+        lag_shaped = _lag_shaped(c)
         rivals = [(r, sensor) for sensor in sensors for r in rivals_of(sensor)]
         # where the α vane's error column is in the fit, the gyros' skew reaches every term
         # through it, and a skew need not be suspected: one not ruled out is asked too
@@ -669,9 +675,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     if euler_lag is None:
         return
     for c in cands:  # a simulation's integration step: the moments lead the rates' derivatives
-        rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
-        if not (c.selected and c.channel in MOMENT_AXES and c.test.startswith("stepwise")
-                and (c.effect == "unsteady_alphadot" or rate_term)):
+        if not (c.selected and c.channel in MOMENT_AXES and c.test.startswith("stepwise") and _lag_shaped(c)):
             continue
         if explains(c, EULER_LAG, euler_lag[1]):
             tau, t, se = euler_lag
