@@ -3,7 +3,8 @@ noise-free data, and the verdict follows its three rules."""
 import numpy as np
 import pytest
 
-from harness.diagnosis.corroborate import AxisRatio, axis_ratio, corroborate, inverse_variance_mean
+from harness.diagnosis.corroborate import (AxisRatio, axis_ratio, corroborate, estimate_correlation,
+                                          inverse_variance_mean, inverse_variance_mean_correlated)
 
 
 def test_axis_ratio_recovers_the_multiple_of_the_signature_exactly():
@@ -94,3 +95,67 @@ def test_inverse_variance_mean_of_two_estimates():
     assert est == pytest.approx((0.10 * 1e4 + 0.13 * 2.5e3) / 1.25e4) and se == pytest.approx(0.01 / np.sqrt(1.25))
     est, se = inverse_variance_mean([1.0, 3.0], [0.5, 0.5])
     assert est == pytest.approx(2.0) and se == pytest.approx(0.5 / np.sqrt(2.0))
+
+
+def test_inverse_variance_mean_of_correlated_estimates():
+    """The same weights, √(wᵀΣw) for the error: equal errors σ correlated ρ give the plain mean
+    and σ√((1 + ρ)/2); fully correlated, the weighted mean of the σ's; uncorrelated, the
+    independent mean's 1/√Σσ⁻²."""
+    est, se = inverse_variance_mean_correlated([1.0, 3.0], [0.5, 0.5], np.array([[1.0, 0.9], [0.9, 1.0]]))
+    assert est == pytest.approx(2.0) and se == pytest.approx(0.5 * np.sqrt(0.95))
+    est, se = inverse_variance_mean_correlated([0.10, 0.13], [0.01, 0.02], np.ones((2, 2)))
+    assert est == pytest.approx(inverse_variance_mean([0.10, 0.13], [0.01, 0.02])[0])
+    assert se == pytest.approx(0.8 * 0.01 + 0.2 * 0.02)
+    assert inverse_variance_mean_correlated([0.10, 0.13], [0.01, 0.02], np.eye(2)) == pytest.approx(
+        inverse_variance_mean([0.10, 0.13], [0.01, 0.02]))
+
+
+def _wander_and_signature(seed: int, n: int = 1500, dt: float = 0.02):
+    from scipy.signal import lfilter
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    signature = np.sin(2 * np.pi * 0.3 * t) + 0.5 * np.sin(2 * np.pi * 0.77 * t)
+    # a Gauss-Markov wander, τ = 1 s, unit variance
+    wander = lfilter([np.sqrt(1 - 0.98 ** 2)], [1.0, -0.98], rng.normal(size=n))
+    return rng, signature, wander
+
+
+def test_estimates_sharing_one_residual_are_fully_correlated_and_independent_ones_are_not():
+    """Two axes whose residuals are the same record (scaled) give estimates correlated 1;
+    independent white residuals give about 0: over 40 seeds within 4/√N_eff of it, the
+    Bartlett window's lags making N_eff ~ N/5 (30 s at 50 Hz), and mostly exactly 0, under
+    twice the scatter of the same statistic on circularly shifted residuals (the chance of
+    more than 8 of 40 there, each 5 %, is under 1e-3)."""
+    rng, sig, _ = _wander_and_signature(0)
+    e = rng.normal(size=sig.size)
+    a, b = axis_ratio(0.1 * sig + e, [], sig), axis_ratio(0.1 * sig + 3 * e, [], 3 * sig)
+    assert estimate_correlation(a, b) == pytest.approx(1.0, abs=1e-9)
+    rhos = []
+    for seed in range(40):
+        rng, sig, _ = _wander_and_signature(seed)
+        a = axis_ratio(rng.normal(size=sig.size), [], sig)
+        b = axis_ratio(2 * rng.normal(size=sig.size), [], sig)
+        rhos.append(estimate_correlation(a, b))
+    assert abs(np.mean(rhos)) < 4 / np.sqrt(40 * sig.size / 5) and np.max(np.abs(rhos)) < 4 / np.sqrt(sig.size / 5)
+    # under 2 of its own scatter (circular shifts) a correlation counts as none: ~95 % of these
+    assert np.mean(np.array(rhos) == 0.0) >= 0.8
+
+
+def test_axes_carrying_one_vane_wander_are_not_three_independent_tests():
+    """C_Y, C_l and C_n each read a β-vane error through the model's slope, so the vane's own
+    wander is in all three (here with a third of each residual white and independent). Each
+    axis alone shows the signature at t ≈ 3.5; combined as independent they would show it at
+    t ≈ 6 and name it; with their correlation the common t stays near the single axis's, under
+    the aerodynamic entry t of 5."""
+    rng, sig, wander = _wander_and_signature(3)
+    ratios = {}
+    for k, slope in (("CY", -1.0), ("Cl", 0.3), ("Cn", 0.5)):
+        e = slope * (wander + 0.5 * rng.normal(size=sig.size))
+        first = axis_ratio(e, [], slope * sig)
+        ratios[k] = axis_ratio(e - 3.5 * first.std_error * slope * sig, [], slope * sig)
+    single = [r.ratio / r.std_error for r in ratios.values()]
+    assert all(2.0 < t < 6.0 for t in single), single
+    independent = inverse_variance_mean([r.ratio for r in ratios.values()], [r.std_error for r in ratios.values()])
+    verdict = corroborate("vane_beta_x", 1.0, 0.3, ratios, t_aero=5.0)
+    assert not verdict.named and "does not show it clearly" in verdict.reason
+    assert verdict.ratio / verdict.ratio_std < 0.7 * independent[0] / independent[1]

@@ -3,6 +3,8 @@ imitate it: a moment-reference shift, a change of lift, a slow lateral drift, a 
 wandering α vane, a rival term, a sensor error or a gyro skew."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.signal import butter, filtfilt
 
@@ -445,28 +447,65 @@ EULER_LAG = "euler_lag"
 MOMENT_AXES = ("Cl", "Cm", "Cn")
 
 
-def euler_lag_estimate(p: Prepared, kin: KinematicResult) -> tuple[float, float, float] | None:
-    """(τ, |t|, standard error) of the lag of the rates' derivatives behind the moments that a
-    simulation integrating rates and attitude by rectangular Euler leaves in its recording,
-    or None when the kinematics do not show one.
+@dataclass(frozen=True)
+class EulerLag:
+    """What the kinematics say of the lag a simulation's rectangular-Euler step leaves
+    between the rates' derivatives and the moments (:func:`euler_lag_estimate`): the gyros'
+    lead they read (s; negative: lagging), its |t| and standard error, and the lags they
+    allow, ``low`` to ``high`` (s, within the physical range 0 to half the sample interval)."""
+
+    tau: float
+    t: float
+    std_error: float
+    low: float
+    high: float
+
+    @property
+    def shown(self) -> bool:
+        """The kinematics see the lead itself (|t| >= :data:`AMBIGUOUS_T`), not only allow it."""
+        return self.tau > 0 and self.t >= AMBIGUOUS_T
+
+
+def _gyro_lead(kin: KinematicResult) -> tuple[float, float, float] | None:
+    """(lead, |t|, standard error) of the rate gyros against the attitude: minus their common
+    skew (:data:`GYRO_UNIT`) or, where only one gyro's skew was estimated (a single-axis
+    maneuver), minus that gyro's."""
+    unit = suspected_estimate(kin, GYRO_UNIT)
+    if unit is None:
+        found = [e for g in GYROS for e in [suspected_estimate(kin, f"skew_{g}")] if e is not None and e[2] > 0]
+        unit = min(found, key=lambda e: e[2], default=None)
+    if unit is None or not np.isfinite(unit[2]) or unit[2] <= 0:
+        return None
+    return -unit[0], unit[1], unit[2]
+
+
+def euler_lag_estimate(p: Prepared, kin: KinematicResult) -> EulerLag | None:
+    """The lag of the rates' derivatives behind the moments that a simulation integrating
+    rates and attitude by rectangular Euler leaves in its recording, as far as the kinematics
+    allow it; None when they rule it out.
 
     With x[k+1] = x[k] + h·ẋ[k] (JSBSim's default for the rotational rates and the attitude),
     the central difference of the attitude at k lags the gyros by h/2, so the kinematics read
     the rate gyros as *leading* by h/2 (a negative common skew, :data:`GYRO_UNIT`), and the
     central difference of the rates, from which ṗ, q̇, ṙ and the moment coefficients are
-    built, lags the moments by the same h/2. Suspected when that skew is negative at
-    |t| >= :data:`AMBIGUOUS_T` and no longer than half the sample interval (a simulation step
-    no longer than the recording's) allows, within :data:`IMITATION_Z` standard errors. A
-    gyro skew cannot stand for it: shifting the rates moves their derivatives the other way
-    (an independent c172x script at 100 Hz, noise-free: the common skew −5 ms, t 360, whose
-    own correction imitated −1.0 of a C_m,α̇ change of +1.66)."""
-    unit = suspected_estimate(kin, GYRO_UNIT)
-    if unit is None or unit[0] >= 0 or unit[1] < AMBIGUOUS_T:
+    built, lags the moments by the same h/2. The lag is physically between 0 and half the
+    sample interval (a simulation step no longer than the recording's); the lags allowed are
+    those within :data:`IMITATION_Z` standard errors of the lead the kinematics read. It is
+    asked whatever the lead's t, as an unresolved gyro skew is where the α vane's error column
+    carries it: at 50 Hz a script's 5 ms lag is under the kinematics' resolution (gyros'
+    lead t 1.4–3.4 on an independent script's c172x three-axis nulls), where it gave
+    C_m,α̇ +1.7 to +2.1 (t 6–8; +1.5 noise-free, where the lead is seen at t 164). A gyro
+    skew cannot stand for it: shifting the rates moves their derivatives the other way (an
+    independent c172x script at 100 Hz, noise-free: the common skew −5 ms, t 360, whose own
+    correction imitated −1.0 of a C_m,α̇ change of +1.66)."""
+    lead = _gyro_lead(kin)
+    if lead is None:
         return None
-    tau, t, se = -unit[0], unit[1], unit[2]
-    if tau - IMITATION_Z * se > p.dt / 2:
+    tau, t, se = lead
+    low, high = max(0.0, tau - IMITATION_Z * se), min(p.dt / 2, tau + IMITATION_Z * se)
+    if high <= 0.0 or low > high:
         return None
-    return tau, t, se
+    return EulerLag(tau, t, se, low, high)
 
 
 def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
@@ -501,7 +540,8 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
     def part(c: Candidate, name: str) -> tuple[float, float] | None:
         """(centre, half-width) of what error ``name`` imitates of ``c``'s change, in its
         direction: per_v·v and IMITATION_Z·|per_v|·σ."""
-        found = euler_lag_estimate(p, kin) if name == EULER_LAG else suspected_estimate(kin, name)
+        lag = euler_lag_estimate(p, kin) if name == EULER_LAG else None
+        found = (lag.high, 1.0, 0.0) if lag is not None else suspected_estimate(kin, name)
         sel, by_key = step.selections.get(c.channel, (None, {}))
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
         change = c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
@@ -526,6 +566,9 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
             before = refit(mismatch[c.channel][inner], cols + fixed)
             after = refit(changed[c.channel][inner], cols + fixed)
         per_v = (before - after) / v   # what an error of size v adds to the term's estimate
+        if lag is not None:  # the most any lag allowed imitates: the interval's ends, as (centre, half-width)
+            ends = [per_v * x * np.sign(change) for x in (lag.low, lag.high)]
+            return 0.5 * (ends[0] + ends[1]), 0.5 * abs(ends[0] - ends[1])
         sigma = abs(v) / t if t > 0 else np.inf
         return per_v * v * np.sign(change), IMITATION_Z * abs(per_v) * sigma
 
@@ -564,7 +607,7 @@ def _named(rival: str | tuple[str, ...]) -> str:
 
 def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None,
                        column_sensors: dict[str, tuple[str, ...]] | None = None,
-                       euler_lag: tuple[float, float, float] | None = None) -> None:
+                       euler_lag: EulerLag | None = None) -> None:
     """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
     channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
     kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
@@ -586,10 +629,10 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     the column is, it withheld six true F-16 and DHC-6 findings of the outside sweep (C_m,α̇
     −3, C_m,q̂ −6, C_n,r̂ −0.3, C_l,p̂ −0.1), whose skews the kinematics bound loosely.
 
-    ``euler_lag`` (:func:`euler_lag_estimate`), when the kinematics show it, is asked of every
-    rate-shaped moment term (C_m,α̇ and the rate derivatives of C_l, C_m, C_n) the same way:
-    withheld when the rates' derivatives lagging the moments by τ, within
-    :data:`IMITATION_Z` standard errors, imitate half its change."""
+    ``euler_lag`` (:func:`euler_lag_estimate`), unless the kinematics rule it out, is asked of
+    every rate-shaped moment term (C_m,α̇ and the rate derivatives of C_l, C_m, C_n) the same
+    way: withheld when the rates' derivatives lagging the moments by any lag it allows
+    imitate half its change."""
 
     asked: set[tuple[int, str]] = set()  # (term, rival) found not to explain it
 
@@ -677,13 +720,16 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     for c in cands:  # a simulation's integration step: the moments lead the rates' derivatives
         if not (c.selected and c.channel in MOMENT_AXES and c.test.startswith("stepwise") and _lag_shaped(c)):
             continue
-        if explains(c, EULER_LAG, euler_lag[1]):
-            tau, t, se = euler_lag
+        lag = euler_lag
+        if explains(c, EULER_LAG, lag.t if lag.shown else 0.0):
             c.selected = False
             c.details["sensor_rival"] = EULER_LAG
-            c.details["euler_lag_s"] = [tau, se]
-            c.reason = (f"entered, but not named: the kinematics read the rate gyros as leading the attitude by "
-                        f"{1000 * tau:.1f} ± {1000 * se:.1f} ms (t = {t:.1f}), as a simulation integrating by "
+            c.details["euler_lag_s"] = [lag.tau, lag.std_error, lag.low, lag.high]
+            read = (f"read the rate gyros as leading the attitude by {1000 * lag.tau:.1f} ± "
+                    f"{1000 * lag.std_error:.1f} ms (t = {lag.t:.1f})" if lag.shown else
+                    f"do not rule out the rate gyros leading the attitude by up to {1000 * lag.high:.1f} ms "
+                    f"(they read {1000 * lag.tau:.1f} ± {1000 * lag.std_error:.1f} ms)")
+            c.reason = (f"entered, but not named: the kinematics {read}, as a simulation integrating by "
                         f"rectangular Euler records them; the rates' derivatives, from which {c.channel} is built, "
                         "then lag the moments by as much, which imitates this term")
 
