@@ -540,8 +540,11 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
     def part(c: Candidate, name: str) -> tuple[float, float] | None:
         """(centre, half-width) of what error ``name`` imitates of ``c``'s change, in its
         direction: per_v·v and IMITATION_Z·|per_v|·σ."""
-        lag = euler_lag_estimate(p, kin) if name == EULER_LAG else None
-        found = (lag.high, 1.0, 0.0) if lag is not None else suspected_estimate(kin, name)
+        if name == EULER_LAG:  # probed at the largest lag allowed; the interval's ends below
+            lag = euler_lag_estimate(p, kin)
+            found = None if lag is None else (lag.high, 1.0, 0.0)
+        else:
+            lag, found = None, suspected_estimate(kin, name)
         sel, by_key = step.selections.get(c.channel, (None, {}))
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
         change = c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
