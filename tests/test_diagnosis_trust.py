@@ -474,6 +474,21 @@ def test_a_sensor_finding_the_validation_contradicts_says_what_the_same_test_gav
     assert "the same test there gives -0.00698 ± 4.3e-05 rad, t = -162.9" in text
 
 
+def test_a_vane_offset_is_explained_as_the_vane_not_the_accelerometer():
+    """verdict.finding_dict: a vane_alpha_x finding was worded as an accelerometer away from
+    the c.g.; it names the vane, the side and the rotation's term."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.verdict import finding_dict
+    ahead = Candidate("sensor_offset", None, "alpha", "vane_alpha_x", 13.09, 1.26, 10.4, 0.1, "ft",
+                      "kinematic consistency", selected=True)
+    text = finding_dict(ahead, {}, {})["explanation"]
+    assert text.startswith("The alpha vane is not at the c.g.") and "13.09 ± 1.26 ft ahead of it (x)" in text
+    assert "−x·q/V" in text and "accelerometer" not in text
+    behind = Candidate("sensor_offset", None, "beta", "vane_beta_x", -4.0, 0.5, -8.0, 0.1, "ft",
+                       "kinematic consistency", selected=True)
+    assert "4.00 ± 0.50 ft behind it (x)" in finding_dict(behind, {}, {})["explanation"]
+
+
 def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
     """term_rules.withhold_ambiguous: a q-scale the kinematics suspect (t 2.6) withholds a
     C_m,q̂ change only when, at a size they allow, it would imitate at least half of it

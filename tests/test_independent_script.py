@@ -109,3 +109,57 @@ def test_rate_derivatives_advanced_removes_a_half_step_euler_lag():
     assert np.max(np.abs(central - w * np.cos(w * t))[inner]) == pytest.approx(lag, rel=0.02)
     fixed = rate_derivatives_advanced(_Rates(t, {"p": central, "q": central, "r": central}), h / 2)
     assert np.max(np.abs(fixed.deriv["q"] - w * np.cos(w * t))[inner]) < 0.05 * lag
+
+
+def _sensor_error(path, column: str, error) -> None:
+    """Rewrite the script's CSV with ``error(t, x)`` in place of ``column`` (the way a recorder's
+    own fault would reach it: after the flight, before anyone reads it)."""
+    import csv
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    head, X = rows[0], np.array(rows[1:], dtype=float)
+    j = head.index(column)
+    X[:, j] = error(X[:, 0], X[:, j])
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(head)
+        writer.writerows([[f"{v:.8g}" for v in row] for row in X])
+
+
+def _first_order_lag(t, x, tau=0.05):
+    a = np.exp(-(t[1] - t[0]) / tau)
+    y = x.copy()
+    for i in range(1, y.size):
+        y[i] = a * y[i - 1] + (1 - a) * x[i]
+    return y
+
+
+def test_an_alpha_vane_80_ms_late_is_not_named_a_vane_ahead_of_the_cg(tmp_path):
+    """A c172x three-axis multisine at 50 Hz (5,000 ft, 190 ft/s) with the α record 80 ms late:
+    the skew's first-order column, τ·α̇, leaves out τ²α̈/2, a quarter of it at the short
+    period, and the linearised kinematics named an α vane 13.1 ft ahead of the c.g. (t 10.4;
+    the skew t 0.8 beside it). Shifted exactly, the skew fits better than the vane at any
+    offset; the vane is contested, and the coefficient mismatch cannot tell them apart:
+    nothing is named (a miss, not a false finding)."""
+    rec = fly(tmp_path / "ms3.csv", "c172x", 5000.0, 190.0, 42, 50.0, "ms3")
+    _sensor_error(rec, "alpha_rad", lambda t, x: np.interp(t - 0.08, t, x))
+    result = diagnose("c172x", rec, tmp_path / "out", calibrate=False)
+    assert _found(result) == []
+    vane = next(c for c in result["candidates"] if c["parameter"] == "vane_alpha_x")
+    assert "the exact shift of skew_alpha" in vane["reason"], vane["reason"]
+
+
+def test_an_accelerometer_lag_is_named_and_the_alphadot_it_imitates_is_not(tmp_path):
+    """The same flight with a_z through a 50 ms first-order lag: the kinematics read an α
+    scale of −0.17 they cannot tell from an a_z skew (r −0.95); C_Z shows the skew (42 ±
+    7 ms) and it is named, but a C_Z,α̇ of +28 stayed named beside it, which the skew at its
+    named size imitates in full. A sensor error named on two tests is preferred over the
+    terms it imitates."""
+    rec = fly(tmp_path / "ms3.csv", "c172x", 5000.0, 190.0, 42, 50.0, "ms3")
+    _sensor_error(rec, "az_g", _first_order_lag)
+    result = diagnose("c172x", rec, tmp_path / "out", calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["skew_az"]
+    assert found[0][1] == pytest.approx(0.05, abs=0.015)
+    term = next(c for c in result["candidates"] if c["parameter"] == "CZ_alphadot")
+    assert "the skew_az named" in term["reason"], term["reason"]

@@ -12,7 +12,8 @@ from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_tes
 from harness.diagnosis.gusts import process_noise_model
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, name_applied, name_corroborated,
-                                             name_vane_bias_from_means, signature_ratios, withhold_vane_scale)
+                                             name_vane_bias_from_means, signature_ratios, withhold_imitated_by_named,
+                                             withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
                                             kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
                                             withhold_offset_of_a_scaled_vane)
@@ -52,7 +53,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)
     plausible = kinematics_plausible(kin, V0, p)
-    contested = contested_parameters(kin)
+    contested = contested_parameters(kin, p)
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
                      if n not in contested}
     recorded, p = p, corrected_recording(p, kin, sensor_values)
@@ -91,8 +92,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
                     measured)
     note_untested_coupling(cands, p)
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
-    withhold_ambiguous(cands, kin, imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0), column_sensors,
-                       euler_lag_estimate(p, kin))
+    imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
+    withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin))
     if turbulent:
         withhold_in_turbulence(cands)
     else:
@@ -113,6 +114,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
             scale_read_as_bias(cands, recorded)
             withhold_offset_of_a_scaled_vane(cands, kin, p, aircraft, ic, as_evaluated, noise, sensor_values)
+            withhold_imitated_by_named(cands, imitated, set(sensor_values))
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += spectral_candidates(peak, gust, turbulent, light, air)

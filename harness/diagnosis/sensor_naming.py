@@ -15,9 +15,10 @@ from harness.diagnosis.along import corrected_recording, inertial_beta, interior
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
-from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_estimate, kinematic_share, kinematic_t,
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
                                             kinematics_refute, sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
+from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel
 from models.aircraft import Aircraft
 from models.hidden import SENSOR_EFFECTS
 from models.replay import InitialCondition
@@ -230,18 +231,20 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
 
 
 def kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature,
-                     contested: dict[str, tuple[str, float, float]]) -> None:
+                     contested: dict[str, Contest]) -> None:
     """A sensor error the kinematics name is kept only when they tell it from its most
     collinear rival (|t| >= their entry t beside it): on a pitch maneuver an α scale factor
-    and an a_z skew both follow α̇ in the ẇ equation. When they cannot, the coefficient
+    and an a_z skew both follow α̇ in the ẇ equation; nor when a collinear time skew fits
+    them better applied exactly (:mod:`exact_skew`). When they cannot, the coefficient
     mismatch decides (:mod:`corroborate`: each rival's computed signature, at its own
     kinematic size, against every axis): the one it corroborates and the other not is named;
     otherwise neither is."""
     by_name = {c.parameter: c for c in cands}
     for c in [c for c in cands if c.selected and c.parameter in contested]:
-        rival, r, t_beside = contested[c.parameter]
+        contest = contested[c.parameter]
+        rival, r, t_beside = contest.rival, contest.correlation, contest.t_beside
         other = by_name.get(rival)
-        solo = kinematic_estimate(kin, rival)
+        solo = contest.rival_estimate or kinematic_estimate(kin, rival)
         verdicts = {}
         for name, (v, t) in ((c.parameter, (c.estimate, abs(c.t))), (rival, solo or (0.0, 0.0))):
             if v == 0.0 or t <= 0:
@@ -252,20 +255,19 @@ def kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, 
         c.details["kinematic_rival"] = {"parameter": rival, "correlation": r, "t_beside": t_beside,
                                         "own": own.as_dict() if own else None,
                                         "rival": theirs.as_dict() if theirs else None}
+        cannot = (f"the kinematics cannot tell it from {rival} (r = {r:+.2f}, "
+                  + (contest.why if contest.why else f"beside it t = {t_beside:.1f}") + ")")
         if own is not None and own.named and not (theirs is not None and theirs.named):
-            c.reason += (f"; the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = {t_beside:.1f}), "
-                         "but the coefficient mismatch shows this one, not that")
+            c.reason += f"; {cannot}, but the coefficient mismatch shows this one, not that"
             continue
         c.selected = False
         if theirs is not None and theirs.named and not (own is not None and own.named) and other is not None:
-            c.reason = (f"not named: the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = "
-                        f"{t_beside:.1f}), and the coefficient mismatch shows {rival}, not this")
+            c.reason = f"not named: {cannot}, and the coefficient mismatch shows {rival}, not this"
             _name_if_corroborated(other, kin, p, theirs, solo[1])
             other.reason = theirs.reason + (f" (kinematic t = {solo[1]:.1f}; the kinematics alone cannot tell it "
                                             f"from {c.parameter})")
         else:
-            c.reason = (f"not named: the kinematics cannot tell it from {rival} (r = {r:+.2f}, beside it t = "
-                        f"{t_beside:.1f}), nor can the coefficient mismatch")
+            c.reason = f"not named: {cannot}, nor can the coefficient mismatch"
         _withhold_absorbed_biases(cands, kin, c.parameter, rival)
 
 
@@ -319,3 +321,30 @@ def _name_if_corroborated(sensor: Candidate, kin: KinematicResult, p: Prepared, 
     sensor.t = verdict.estimate / verdict.std_error
     sensor.reason = verdict.reason + f" (kinematic t = {t_kin:.1f}, below their entry t alone)"
     return True
+
+
+def withhold_imitated_by_named(cands: list[Candidate], imitated, applied: set[str]) -> None:
+    """Deselect the aerodynamic terms a sensor error named on two tests (and not applied to
+    the channels, ``applied``) imitates: half the term's change or more
+    (:data:`term_rules.IMITATION_SHARE`) within :data:`term_rules.IMITATION_Z` standard errors of
+    the error's named size (``imitated``, :func:`term_rules.imitation`, computed with the
+    channels corrected). The error reaches the terms of the axes measured with its channel
+    (:data:`term_rules.DEPENDENT_SENSOR`) and those whose regressor it is; it is preferred
+    over the coefficient changes it imitates. (A c172x recording at 5,000 ft / 190 ft/s whose
+    a_z lagged 50 ms through a first-order filter named the a_z skew, 42 ± 7 ms, on the
+    kinematics and C_Z together, and beside it a C_Z,α̇ of +28 that the skew imitates.)"""
+    named = [c for c in cands if c.selected and c.effect in SENSOR_EFFECTS and c.parameter not in applied]
+    for sensor in named:
+        channel = sensor.channel
+        for c in cands:
+            reached = channel in (DEPENDENT_SENSOR.get(c.channel or ""), regressor_channel(c))
+            if not (c.selected and reached and c.test.startswith("stepwise")):
+                continue
+            change = abs(c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate)
+            size = imitated(c, sensor.parameter, (sensor.estimate, sensor.std_error))
+            if size is None or size < IMITATION_SHARE * change:
+                continue
+            c.selected = False
+            c.details["sensor_rival"] = sensor.parameter
+            c.reason = (f"entered, but not named: the {sensor.parameter} named ({sensor.estimate:.3g} ± "
+                        f"{sensor.std_error:.2g} {sensor.units}) imitates {size:.2g} of this change of {change:.3g}")

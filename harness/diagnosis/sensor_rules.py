@@ -3,6 +3,8 @@ that reads as a bias, the rivals and refutations the kinematics give, and the ki
 estimates the other rules consult."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from estimators.colored_stepwise import colored_fit
@@ -12,6 +14,7 @@ from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, model_along
 from harness.diagnosis.corroborate import inverse_variance_mean
 from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.exact_skew import skew_rival
 from harness.diagnosis.gust_rules import NOT_IN_TURBULENCE
 from harness.diagnosis.kinematics import KinematicResult, channel_share, is_plausible, is_practical, kinematic_check
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
@@ -241,6 +244,19 @@ APPLY_T = 3.0
 AMBIGUOUS_T = 2.5
 
 
+@dataclass(frozen=True)
+class Contest:
+    """A selected kinematic term's rival the kinematics cannot rule out: its name, their
+    partial correlation, the term's |t| beside it and, where the rival's own estimate is
+    not the linearised fit's (an exact shift), that estimate and |t|, with why."""
+
+    rival: str
+    correlation: float
+    t_beside: float
+    rival_estimate: tuple[float, float] | None = None
+    why: str = ""
+
+
 def kinematic_estimate(kin: KinematicResult, name: str) -> tuple[float, float] | None:
     """A kinematic parameter's estimate and |t|, whether it entered the fit (its final value)
     or not (its value when tried in the final model); None when it was not a candidate."""
@@ -358,19 +374,25 @@ def kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float,
     return best[0], best[1], t_own, t_rival
 
 
-def contested_parameters(kin: KinematicResult) -> dict[str, tuple[str, float, float]]:
+def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dict[str, Contest]:
     """The selected kinematic terms the kinematics cannot tell from a rival
     (:func:`kinematic_rival`: |t| beside it below their entry t, unless it stays at least
-    :data:`AMBIGUOUS_T` there while the rival falls below it): not applied to the channels, so
-    that the coefficient mismatch can judge between the two (:func:`kinematic_rivals`)."""
+    :data:`AMBIGUOUS_T` there while the rival falls below it), and, given the recording ``p``,
+    those a collinear time skew applied as the exact shift fits better
+    (:func:`exact_skew.skew_rival`): not applied to the channels, so that the coefficient
+    mismatch can judge between the two (:func:`kinematic_rivals`)."""
     out = {}
     for n in kin.selection.names:
         found = kinematic_rival(kin, n)
-        if found is None or found[2] >= KIN_T_IN:
+        if found is not None and found[2] < KIN_T_IN and not (found[2] >= AMBIGUOUS_T and found[3] < AMBIGUOUS_T):
+            out[n] = Contest(*found[:3])
             continue
-        if found[2] >= AMBIGUOUS_T and found[3] < AMBIGUOUS_T:
-            continue  # beside each other, the data still prefer this one
-        out[n] = found[:3]
+        exact = skew_rival(kin, p, n) if p is not None else None
+        if exact is not None:
+            out[n] = Contest(exact.rival, exact.correlation, kinematic_t(kin, n), (exact.tau, exact.t),
+                             f"the exact shift of {exact.rival} at {1000 * exact.tau:.1f} ms leaves less kinematic "
+                             f"residual ({exact.rss_skew:.0f} against {exact.rss_term:.0f}) than its first-order "
+                             "column lets the linearised fit see")
     return out
 
 

@@ -537,12 +537,15 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         A = np.column_stack(cols + [np.ones(z.size)])
         return float(np.linalg.lstsq(A, z, rcond=None)[0][0])
 
-    def part(c: Candidate, name: str) -> tuple[float, float] | None:
+    def part(c: Candidate, name: str, at: tuple[float, float] | None = None) -> tuple[float, float] | None:
         """(centre, half-width) of what error ``name`` imitates of ``c``'s change, in its
-        direction: per_v·v and IMITATION_Z·|per_v|·σ."""
+        direction: per_v·v and IMITATION_Z·|per_v|·σ; v ± σ the kinematic estimate, or ``at``
+        (an error named on two tests, at its combined size)."""
         if name == EULER_LAG:  # probed at the largest lag allowed; the interval's ends below
             lag = euler_lag_estimate(p, kin)
             found = None if lag is None else (lag.high, 1.0, 0.0)
+        elif at is not None:
+            lag, found = None, (at[0], abs(at[0]) / at[1] if at[1] > 0 else np.inf, at[1])
         else:
             lag, found = None, suspected_estimate(kin, name)
         sel, by_key = step.selections.get(c.channel, (None, {}))
@@ -575,12 +578,13 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         sigma = abs(v) / t if t > 0 else np.inf
         return per_v * v * np.sign(change), IMITATION_Z * abs(per_v) * sigma
 
-    def imitated(c: Candidate, name: str | tuple[str, ...]) -> float | None:
-        """The most ``name`` imitates within IMITATION_Z standard errors; for several errors
-        at once (a tuple), within that many of their joint estimate (independent: the centres
-        add, the half-widths in quadrature)."""
+    def imitated(c: Candidate, name: str | tuple[str, ...], at: tuple[float, float] | None = None) -> float | None:
+        """The most ``name`` imitates within IMITATION_Z standard errors (of ``at``, estimate
+        and standard error, when given); for several errors at once (a tuple), within that
+        many of their joint estimate (independent: the centres add, the half-widths in
+        quadrature)."""
         names = (name,) if isinstance(name, str) else name
-        parts = [part(c, n) for n in names]
+        parts = [part(c, n, at) for n in names]
         if any(x is None for x in parts):
             return None
         return sum(x[0] for x in parts) + float(np.sqrt(sum(x[1] ** 2 for x in parts)))
@@ -597,6 +601,17 @@ def _lag_shaped(c: Candidate) -> bool:
     derivative), the shape a lag imitates, rather than its level."""
     rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
     return c.effect == "unsteady_alphadot" or rate_term
+
+
+def regressor_channel(c: Candidate) -> str | None:
+    """The measured channel term ``c``'s regressor is built on: a derivative's own (C_m,q̂ on
+    q), and α for an α̇ term. The model is evaluated along the α vane, so an error of the vane
+    (a lag: −τα̇ times the model's slope; a vane ahead: −x·q/V) reaches the mismatch as a
+    term in α̇: a c172x recording whose α was 80 ms late named a C_Z,α̇ of −55 that the α
+    vane's suspected error imitates."""
+    if c.effect == "unsteady_alphadot":
+        return "alpha"
+    return cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
 
 
 def _named(rival: str | tuple[str, ...]) -> str:
@@ -675,9 +690,9 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     for c in cands:
         if c.selected and c.effect == "control_delay":
             _withhold_skewed_delay(c, kin)
-        if not (c.selected and c.effect == "coefficient_error"):
+        if not (c.selected and c.effect in ("coefficient_error", "unsteady_alphadot")):
             continue
-        channel = cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
+        channel = regressor_channel(c)
         found = next((r for r in rivals_of(channel) if explains(c, *r)), None)
         if found is not None:
             rival, t = found
@@ -685,7 +700,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             c.details["sensor_rival"] = rival
             c.details["suspicion"] = {"parameter": rival, "t": t}
             c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({_named(rival)}, "
-                        f"kinematic t = {t:.1f}), which a wrong derivative on {channel} would imitate")
+                        f"kinematic t = {t:.1f}), an error that would imitate this term")
     for c in cands:  # the sensors the coefficient itself is measured with
         sensors = (DEPENDENT_SENSOR.get(c.channel or ""),) + (column_sensors or {}).get(c.channel or "", ())
         # a lag imitates terms that follow the coefficient's rate of change, not its level

@@ -188,6 +188,12 @@ EXPLAIN_VANE_MEANS = ("The {channel} vane reads {estimate:.4g} ± {std_error:.2g
                       "along it is off by its own slopes in that angle times one constant on every axis it reaches.")
 
 
+# A flow-angle vane away from the c.g. (kinematics.sensor_parameters' vane_alpha_x, vane_beta_x).
+EXPLAIN_VANE_OFFSET = ("The {channel} vane is not at the c.g.: it reads the flow of a point about {abs_estimate:.2f} ± "
+                       "{std_error:.2f} ft {ahead} it ({component}), where the rotation adds {rotation} to the angle.")
+_VANE_ROTATION = {"alpha": "−x·q/V", "beta": "x·r/V"}
+
+
 def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = None) -> dict:
     fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
            "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
@@ -200,7 +206,9 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     fmt["product"] = "|beta|, an even function of sideslip" if even else "(alpha - alpha_trim)·beta"
     fmt["even"] = (" (or, as here, the model has one of opposite sign: a symmetric airframe's rolling and yawing "
                    "moments are odd in sideslip)") if even else ""
+    fmt["rotation"] = _VANE_ROTATION.get(c.channel or "", "")
     template = (EXPLAIN_VANE_MEANS if c.test in MEANS_TESTS.values() else
+                EXPLAIN_VANE_OFFSET if c.parameter.startswith("vane_") else
                 EXPLAIN_LIGHT_TURBULENCE if c.details.get("light") else EXPLAIN[c.effect])
     share = c.details.get("air_share") or {}
     fmt["air_share"], fmt["air_share_se"] = share.get("share", float("nan")), share.get("std_error", float("nan"))
