@@ -14,11 +14,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
+from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis.kinematics import kinematic_alpha_rate
 from harness.diagnosis.prepare import Prepared, filtered_noise_std, interior_slice
 from models.constants import SURFACES
 
 T_IN = 5.0
+# A sensor parameter at this |t| is suspected, below its entry t: it keeps the terms it would
+# imitate from being named, and beside a rival the data still prefer it while the rival
+# falls below this (sensor_rules.contested_parameters, offset_rival).
+AMBIGUOUS_T = 2.5
 MIN_GAIN = 0.05
 LON = ("CX", "CZ", "Cm")
 LAT = ("CY", "Cl", "Cn")
@@ -92,6 +97,10 @@ def effective_derivatives(p: Prepared, axis: str, model: np.ndarray) -> dict[str
     return {f"{axis}_{r}": float(v) for r, v in zip(names, theta)}
 
 
+# The derivatives a coefficient error is offered on, per axis group (seed Eqs. 6-11).
+OWN_REGRESSORS = {"lon": ("alpha", "qhat", "de"), "lat": ("beta", "phat", "rhat", "da", "dr")}
+
+
 def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dict[str, np.ndarray],
             model: dict[str, np.ndarray] | None = None) -> list[Term]:
     """The candidate terms for the mismatch of coefficient ``axis``. With ``model`` (the
@@ -103,7 +112,7 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
     a = reg["alpha"]
     units_of = {"qhat": "per rad (q normalised by c/2V)", "phat": "per rad (p normalised by b/2V)",
                 "rhat": "per rad (r normalised by b/2V)"}
-    own = ("alpha", "qhat", "de") if axis in LON else ("beta", "phat", "rhat", "da", "dr")
+    own = OWN_REGRESSORS["lon" if axis in LON else "lat"]
     values = dict(derivatives)
     if model is not None:
         values.update(effective_derivatives(p, axis, model[axis]))
@@ -263,8 +272,8 @@ def delay_scan(p: Prepared, surface: str, mismatch: dict[str, np.ndarray], deriv
         ind[i] = 1.0
         intercepts.append(np.tile(ind, (inner.stop - inner.start, 1)))
     Z, G, I = np.concatenate(z), np.concatenate(col), np.vstack(intercepts)
-    theta, se, _ = colored_fit(Z, [G] + [I[:, i] for i in range(len(axes))], ["dtau"] + [f"b{i}" for i in range(len(axes))],
-                               constant=False)
+    theta, se, _ = colored_fit(Z, [G] + [I[:, i] for i in range(len(axes))],
+                               ["dtau"] + [f"b{i}" for i in range(len(axes))], constant=False)
     tau_hat = tau + float(theta[0]) if tau > 0 else float(theta[0])
     std = float(se[0])
     columns = {}
@@ -300,19 +309,30 @@ class OffsetTest:
     gain: float
 
 
+FORCE_AXES = ("CX", "CY", "CZ")
+
+
+def _stacked_forces(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]):
+    """The force mismatches' interiors stacked and noise-weighted, the accelerometer
+    position's columns stacked alike (per component), and an intercept per axis."""
+    cols = accelerometer_columns(p)
+    inner = interior_slice(p.n, p.dt)
+    m = inner.stop - inner.start
+    Z = np.concatenate([mismatch[c][inner] / noise[c] for c in FORCE_AXES])
+    X = {a: np.concatenate([cols[a][c][inner] / noise[c] for c in FORCE_AXES]) for a in "xyz"}
+    I = [np.concatenate([np.full(m, 1.0 if c == ci else 0.0) for c in FORCE_AXES]) for ci in FORCE_AXES]
+    return Z, X, I
+
+
 def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]) -> OffsetTest:
     """Least squares of the stacked, noise-weighted force mismatches on the accelerometer
     position (with an intercept per axis), colored-residual standard errors."""
-    cols = accelerometer_columns(p)
-    inner = interior_slice(p.n, p.dt)
-    axes = ("CX", "CY", "CZ")
-    m = inner.stop - inner.start
-    Z = np.concatenate([mismatch[c][inner] / noise[c] for c in axes])
-    X = [np.concatenate([cols[a][c][inner] / noise[c] for c in axes]) for a in "xyz"]
-    I = [np.concatenate([np.full(m, 1.0 if c == ci else 0.0) for c in axes]) for ci in axes]
+    Z, X, I = _stacked_forces(p, mismatch, noise)
+    X = [X[a] for a in "xyz"]
     keep = [i for i in range(3) if np.ptp(X[i]) > 1e-12]
-    theta, se, resid = colored_fit(Z, [X[i] for i in keep] + I, [f"r{i}" for i in keep] + list(axes), constant=False)
-    _, _, r0 = colored_fit(Z, I, list(axes), constant=False)
+    theta, se, resid = colored_fit(Z, [X[i] for i in keep] + I, [f"r{i}" for i in keep] + list(FORCE_AXES),
+                                   constant=False)
+    _, _, r0 = colored_fit(Z, I, list(FORCE_AXES), constant=False)
     pos, ses = [0.0, 0.0, 0.0], [np.inf, np.inf, np.inf]
     for j, i in enumerate(keep):
         pos[i], ses[i] = float(theta[j]), float(se[j])
@@ -333,3 +353,70 @@ def axis_selection(p: Prepared, axis: str, mismatch: np.ndarray, terms: list[Ter
     nuisance = {key: col[inner] for key, col in (forced or {}).items() if np.ptp(col[inner]) > 0}
     return colored_forward_selection(mismatch[inner], cands, forced=nuisance, t_in=T_IN, min_gain=MIN_GAIN,
                                      max_terms=3)
+
+
+@dataclass(frozen=True)
+class OffsetRival:
+    """A coefficient error the force mismatch cannot tell from the accelerometer's offset."""
+
+    parameter: str        # e.g. CY_beta
+    correlation: float    # partial, of its stacked column with the offset's component
+    t_offset: float       # the offset component's t beside it
+    t_rival: float        # its t beside the offset
+
+
+# Only derivatives whose stacked column is at least this correlated with the offset's
+# component are tried beside it (the test needs collinearity; the others cost a fit each).
+OFFSET_RIVAL_CORRELATION = 0.3
+
+
+def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                 off: OffsetTest) -> OffsetRival | None:
+    """The coefficient error (a force axis's own derivative, :data:`OWN_REGRESSORS`) the
+    force mismatch cannot tell from the accelerometer's position (:func:`accelerometer_offset`):
+    fitted beside it, the position's strongest component falls below the entry t, unless it
+    stays at :data:`AMBIGUOUS_T` while the derivative falls below that (the data still prefer
+    the position: the kinematic rivals' rule, ``sensor_rules.contested_parameters``); the one
+    that takes most from the position. An accelerometer ahead of the c.g. adds x·ṙ/g to a_y,
+    and on a lateral maneuver ṙ follows β and the rudder: a C_Y,β 0.3 more negative, flown
+    into F-16 XML copies (5° lateral multisines), read as an accelerometer 2.2 ft aft at
+    10,000 ft / 427 ft/s (t −8.0; beside C_Y,β −1.4, C_Y,β −7.2 beside it) and 2.9 ft aft at
+    20,000 ft / 600 ft/s (t −10.5; −1.6 and −2.7). True offsets of 5 and 10 ft on the sweeps'
+    pitch and three-axis maneuvers kept t 3.7-10 beside every derivative, none of which
+    reached |t| 2.1 beside them. None when there is no such term."""
+    k = int(np.argmax(np.abs(off.t)))
+    if not np.isfinite(off.std_error_ft[k]):
+        return None
+    Z, X, I = _stacked_forces(p, mismatch, noise)
+    inner = interior_slice(p.n, p.dt)
+    m, axes = inner.stop - inner.start, FORCE_AXES
+    keep = [a for a in "xyz" if np.ptp(X[a]) > 1e-12]
+    name = "xyz"[k]
+    others = [X[a] for a in keep if a != name] + I
+    A = np.column_stack(others)
+
+    def partial(v: np.ndarray) -> np.ndarray:
+        return v - A @ np.linalg.lstsq(A, v, rcond=None)[0]
+    target = partial(X[name])
+    reg = regressors(p)
+    best = None
+    for axis in axes:
+        for r in OWN_REGRESSORS["lon" if axis in LON else "lat"]:
+            if r not in reg or np.ptp(reg[r][inner]) <= 0:
+                continue
+            col = np.concatenate([reg[r][inner] / noise[c] if c == axis else np.zeros(m) for c in axes])
+            other = partial(col)
+            corr = float(target @ other / np.sqrt((target @ target) * (other @ other)))
+            if abs(corr) < OFFSET_RIVAL_CORRELATION:
+                continue
+            try:
+                theta, se, _ = colored_fit(Z, [X[a] for a in keep] + I + [col], keep + list(axes) + ["rival"],
+                                           constant=False)
+            except (SingularRegressorsError, np.linalg.LinAlgError):
+                continue
+            j = keep.index(name)
+            t_off, t_rival = float(theta[j] / se[j]), float(theta[-1] / se[-1])
+            prefers_offset = abs(t_off) >= AMBIGUOUS_T and abs(t_rival) < AMBIGUOUS_T
+            if abs(t_off) < T_IN and not prefers_offset and (best is None or abs(t_off) < abs(best.t_offset)):
+                best = OffsetRival(f"{axis}_{r}", corr, t_off, t_rival)
+    return best

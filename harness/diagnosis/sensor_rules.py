@@ -241,7 +241,7 @@ APPLY_T = 3.0
 # named: a scaled α (or β, q ...) reading is exactly a scaled derivative on α. A bias is not
 # a rival: the regression's constant absorbs it (it imitates a derivative only through the
 # model's nonlinearity).
-AMBIGUOUS_T = 2.5
+AMBIGUOUS_T = cand.AMBIGUOUS_T
 
 
 @dataclass(frozen=True)

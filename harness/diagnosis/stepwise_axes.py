@@ -32,16 +32,22 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
                                         1.0, measured[c][inner]) for c in ("CX", "CY", "CZ"))
     sel = (max(abs(v) for v in off.t) >= cand.T_IN and abs(x) >= PRACTICAL["offset_ft"]
            and off.gain >= cand.MIN_GAIN / 2 and share >= cand.PRACTICAL_SHARE)
+    reason = "significant and practical" if sel else \
+        "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion"
+    rival = cand.offset_rival(p, mismatch, noise, off) if sel else None
+    if rival is not None:  # the mismatch is left whole for the stepwise fits to judge
+        sel = False
+        reason = (f"not named: the force mismatch cannot tell it from {rival.parameter} (r = {rival.correlation:+.2f}): "
+                  f"beside it the position stands at t = {rival.t_offset:.1f}, and {rival.parameter} at t = "
+                  f"{rival.t_rival:.1f} beside the position; the mismatch is left to the stepwise fits")
     if sel:
         for i, a in enumerate("xyz"):
             for c in ("CX", "CY", "CZ"):
                 mismatch[c] = mismatch[c] - off.position_ft[i] * cols[a][c]
     return off, Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
-                          x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", sel,
-                          "significant and practical" if sel else
-                          "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion",
+                          x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", sel, reason,
                           {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
-                           "t_xyz": list(off.t)})
+                           "t_xyz": list(off.t)} | ({"offset_rival": rival.parameter} if rival else {}))
 
 
 def delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
