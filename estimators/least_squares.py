@@ -110,3 +110,25 @@ def r_squared(z: np.ndarray, residuals: np.ndarray) -> float:
     """1 − Σ|z − ŷ|² / Σ|z − z̄|²."""
     ss_tot = float(np.sum(np.abs(z - z.mean()) ** 2))
     return 1.0 - float(np.sum(np.abs(residuals) ** 2)) / ss_tot if ss_tot > 0 else float("nan")
+
+
+# What is left of a vector its columns explain, relative to its norm, below which it is rounding.
+NOTHING_LEFT = 1e-10
+
+
+def residual_after(x: np.ndarray, columns: list[np.ndarray]) -> np.ndarray:
+    """``x`` less its least-squares fit on ``columns`` (``x`` itself when there are none): the
+    part of a regressor or a measurement the columns cannot explain."""
+    if not columns:
+        return np.asarray(x, dtype=float)
+    A = np.column_stack(columns)
+    return x - A @ np.linalg.lstsq(A, x, rcond=None)[0]
+
+
+def partial_correlation(a: np.ndarray, b: np.ndarray, columns: list[np.ndarray]) -> float:
+    """The correlation of ``a`` and ``b`` once their fits on ``columns`` are taken out (0 when
+    either has nothing left beyond rounding: :data:`NOTHING_LEFT` of its own norm)."""
+    ra, rb = residual_after(a, columns), residual_after(b, columns)
+    if any(np.linalg.norm(r) <= NOTHING_LEFT * np.linalg.norm(x) for r, x in ((ra, a), (rb, b))):
+        return 0.0
+    return float(ra @ rb) / float(np.linalg.norm(ra) * np.linalg.norm(rb))

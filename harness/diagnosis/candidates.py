@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
-from estimators.least_squares import SingularRegressorsError
+from estimators.least_squares import SingularRegressorsError, partial_correlation
 from harness.diagnosis.kinematics import kinematic_alpha_rate
 from harness.diagnosis.prepare import Prepared, filtered_noise_std, interior_slice
 from models.constants import SURFACES
@@ -393,11 +393,6 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
     keep = [a for a in "xyz" if np.ptp(X[a]) > 1e-12]
     name = "xyz"[k]
     others = [X[a] for a in keep if a != name] + I
-    A = np.column_stack(others)
-
-    def partial(v: np.ndarray) -> np.ndarray:
-        return v - A @ np.linalg.lstsq(A, v, rcond=None)[0]
-    target = partial(X[name])
     reg = regressors(p)
     best = None
     for axis in axes:
@@ -405,8 +400,7 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
             if r not in reg or np.ptp(reg[r][inner]) <= 0:
                 continue
             col = np.concatenate([reg[r][inner] / noise[c] if c == axis else np.zeros(m) for c in axes])
-            other = partial(col)
-            corr = float(target @ other / np.sqrt((target @ target) * (other @ other)))
+            corr = partial_correlation(X[name], col, others)
             if abs(corr) < OFFSET_RIVAL_CORRELATION:
                 continue
             try:

@@ -12,8 +12,8 @@ shifted by exactly 80 ms leaves less kinematic residual than the vane at any off
 So a selected sensor term is contested (the coefficient mismatch then decides,
 :func:`harness.diagnosis.sensor_naming.kinematic_rivals`) when a collinear time skew,
 applied as the exact shift x(t + τ) at its best τ, leaves less residual than the term itself
-applied exactly at its estimate, with the other selected terms and the forced biases fitted
-beside each.
+applied exactly at its best size near its estimate, with the other selected terms and the
+forced biases fitted beside each.
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from estimators.colored_stepwise import colored_fit
-from estimators.least_squares import SingularRegressorsError
+from estimators.least_squares import SingularRegressorsError, partial_correlation, residual_after
 from harness.diagnosis.kinematics import KinematicResult, kinematic_residuals
 from harness.diagnosis.prepare import Prepared, interior_slice
 
@@ -69,39 +69,28 @@ def stacked_residual(ch: dict[str, np.ndarray], p: Prepared, kin: KinematicResul
 
 
 def _rss(z: np.ndarray, fixed: list[np.ndarray]) -> float:
-    if not fixed:
-        return float(z @ z)
-    A = np.column_stack(fixed)
-    r = z - A @ np.linalg.lstsq(A, z, rcond=None)[0]
+    r = residual_after(z, fixed)
     return float(r @ r)
-
-
-def _partial(x: np.ndarray, fixed: list[np.ndarray]) -> np.ndarray:
-    if not fixed:
-        return x
-    A = np.column_stack(fixed)
-    return x - A @ np.linalg.lstsq(A, x, rcond=None)[0]
 
 
 def skew_rival(kin: KinematicResult, p: Prepared, name: str) -> SkewRival | None:
     """The collinear time skew (:data:`SKEW_RIVAL_CORRELATION`) that, applied as the exact
     shift at its best τ, leaves less kinematic residual than selected term ``name`` applied
-    exactly at its estimate (module docstring); None when there is none."""
+    exactly at its best size near its estimate (module docstring); None when there is none."""
     cols = kin.columns or {}
     if name not in cols or name.startswith("skew_"):
         return None
     others = [n for n in kin.forced + kin.selection.names if n != name and n in cols]
     fixed = [cols[n] for n in others]
     raw = dict(p.raw)
-    own = _best_exact(lambda v: _rss(stacked_residual(kin.parameters[name].correct(raw, p, v), p, kin), fixed),
-                      kin.selection.params[name], 0.0)
-    a = _partial(cols[name], fixed)
+    sp = kin.parameters[name]
+    own = _best_exact(lambda v: _rss(stacked_residual(sp.correct(raw, p, v), p, kin), fixed),
+                      kin.selection.params[name], sp.step)
     best = None
     for rival, col in cols.items():
         if not rival.startswith("skew_") or rival in others or np.ptp(col) <= 0:
             continue
-        b = _partial(col, fixed)
-        r = float(a @ b / np.sqrt((a @ a) * (b @ b))) if b @ b > 0 else 0.0
+        r = partial_correlation(cols[name], col, fixed)
         if abs(r) < SKEW_RIVAL_CORRELATION:
             continue
         try:  # the linearised skew in the term's place: its start and standard error

@@ -18,7 +18,7 @@ from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
                                             kinematics_refute, sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
-from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel
+from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel, term_change
 from models.aircraft import Aircraft
 from models.hidden import SENSOR_EFFECTS
 from models.replay import InitialCondition
@@ -340,7 +340,7 @@ def withhold_imitated_by_named(cands: list[Candidate], imitated, applied: set[st
             reached = channel in (DEPENDENT_SENSOR.get(c.channel or ""), regressor_channel(c))
             if not (c.selected and reached and c.test.startswith("stepwise")):
                 continue
-            change = abs(c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate)
+            change = abs(term_change(c))
             size = imitated(c, sensor.parameter, (sensor.estimate, sensor.std_error))
             if size is None or size < IMITATION_SHARE * change:
                 continue

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from estimators.colored_stepwise import colored_fit
-from estimators.least_squares import SingularRegressorsError
+from estimators.least_squares import SingularRegressorsError, partial_correlation
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, model_along
@@ -348,17 +348,11 @@ def kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float,
     if name not in cols:
         return None
     fixed = [n for n in kin.forced + kin.selection.names if n != name and n in cols]
-    F = np.column_stack([cols[n] for n in fixed]) if fixed else np.zeros((kin.start.size, 0))
-
-    def partial(x: np.ndarray) -> np.ndarray:  # x with the fixed columns' part removed
-        return x - F @ np.linalg.lstsq(F, x, rcond=None)[0] if fixed else x
-    a = partial(cols[name])
     best = None
     for other, col in cols.items():
         if other in fixed or other == name or np.ptp(col) <= 0:
             continue
-        b = partial(col)
-        r = float(np.dot(a, b) / np.sqrt(np.dot(a, a) * np.dot(b, b))) if np.dot(b, b) > 0 else 0.0
+        r = partial_correlation(cols[name], col, [cols[n] for n in fixed])
         if abs(r) >= rivals.RIVAL_CORRELATION and (best is None or abs(r) > abs(best[1])):
             best = (other, r)
     if best is None:

@@ -550,7 +550,7 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
             lag, found = None, suspected_estimate(kin, name)
         sel, by_key = step.selections.get(c.channel, (None, {}))
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
-        change = c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
+        change = term_change(c)
         if found is None or key is None or not found[0] or not change:
             return None
         v, t, _ = found
@@ -601,6 +601,12 @@ def _lag_shaped(c: Candidate) -> bool:
     derivative), the shape a lag imitates, rather than its level."""
     rate_term = c.effect == "coefficient_error" and c.parameter.split("_", 1)[1] in ("qhat", "phat", "rhat")
     return c.effect == "unsteady_alphadot" or rate_term
+
+
+def term_change(c: Candidate) -> float:
+    """What term ``c`` changes in the model: a coefficient error's change from the model's
+    value, any other term's whole estimate (the model has none)."""
+    return c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate
 
 
 def regressor_channel(c: Candidate) -> str | None:
@@ -676,7 +682,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
         if (id(c), rival) in asked:
             return False  # asked already (the regressor's sensor and the coefficient's)
         size = None if imitated is None else imitated(c, rival)
-        change = abs(c.details.get("change", c.estimate) if c.effect == "coefficient_error" else c.estimate)
+        change = abs(term_change(c))
         if size is None or size >= IMITATION_SHARE * change:
             return True
         asked.add((id(c), rival))
