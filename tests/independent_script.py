@@ -42,15 +42,10 @@ def inputs(kind: str, amplitude_rad: float, duration_s: float, rng: np.random.Ge
     return out
 
 
-def fly(path: Path, model: str, h_ft: float, V_fps: float, seed: int, out_hz: float, kind: str,
-        units: str = "si", noise: float = 1.0, duration_s: float = 28.0, amplitude_deg: float = 2.0,
-        xml_placement: bool = True, root: str | None = None) -> Path:
-    """Fly ``model`` and write ``path`` (CSV) beside its ``.meta.json``; the 737's aerodynamic
-    reference point stays where its XML puts it unless ``xml_placement`` is False (then it is
-    moved onto the c.g., as shared/jsbsim-notes.md suggests for exact truth); ``root`` is a
-    JSBSim root folder holding a modified copy of the aircraft (default: the package's)."""
+def trimmed(model: str, h_ft: float, V_fps: float, sim_hz: float = 100.0, xml_placement: bool = True,
+            root: str | None = None):
+    """``model`` trimmed by JSBSim in level flight at ``h_ft`` and ``V_fps``, gear up (see :func:`fly`)."""
     import jsbsim
-    sim_hz = 200.0 if 100.0 % out_hz else 100.0
     fdm = jsbsim.FGFDMExec(root)
     fdm.set_debug_level(0)
     assert fdm.load_model(model)
@@ -67,6 +62,18 @@ def fly(path: Path, model: str, h_ft: float, V_fps: float, seed: int, out_hz: fl
     fdm["gear/gear-pos-norm"] = 0.0
     fdm["fcs/throttle-cmd-norm"] = 0.7
     fdm.do_trim(1)
+    return fdm
+
+
+def fly(path: Path, model: str, h_ft: float, V_fps: float, seed: int, out_hz: float, kind: str,
+        units: str = "si", noise: float = 1.0, duration_s: float = 28.0, amplitude_deg: float = 2.0,
+        xml_placement: bool = True, root: str | None = None) -> Path:
+    """Fly ``model`` and write ``path`` (CSV) beside its ``.meta.json``; the 737's aerodynamic
+    reference point stays where its XML puts it unless ``xml_placement`` is False (then it is
+    moved onto the c.g., as shared/jsbsim-notes.md suggests for exact truth); ``root`` is a
+    JSBSim root folder holding a modified copy of the aircraft (default: the package's)."""
+    sim_hz = 200.0 if 100.0 % out_hz else 100.0
+    fdm = trimmed(model, h_ft, V_fps, sim_hz, xml_placement, root)
     fdm["simulation/models/FGFCS/enabled"] = 0
     props = dict(zip(("de", "da", "dr"), SURFACE_PROPERTIES[model]))
     trim = {s: fdm[p] for s, p in props.items()}

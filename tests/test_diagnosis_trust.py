@@ -1346,3 +1346,39 @@ def test_the_rate_gyros_common_skew_pools_their_own():
     apart = kin(p=(-4.9e-3, 1.0e-3), q=(+4.0e-3, 1.0e-3))   # each 4.45 standard errors from the mean
     assert GYRO_AGREE_Z < 4.45 and suspected_estimate(apart, GYRO_UNIT) is None
     assert suspected_estimate(kin(q=(-4.2e-3, 2.3e-3)), GYRO_UNIT) is None
+
+
+def _jet_drift_case(estimate: float, raw: dict | None = None):
+    from types import SimpleNamespace
+    from harness.diagnosis.evidence import Candidate
+    p = SimpleNamespace(meta={"geometry": {"S_ft2": 300.0, "b_ft": 30.0, "cbar_ft": 11.32}}, raw=raw or {})
+    trim = SimpleNamespace(thrust_lbf=2000.0, thrust_offset_ft=-0.3, qbar_psf=160.0)
+    c = Candidate("flight_condition_drift", "pitch", "Cm", "Cm_dV", estimate, 0.0005, estimate / 0.0005, 0.1,
+                  "per unit dV/V", "stepwise on the Cm mismatch", True, "entered")
+    return p, trim, c
+
+
+def test_the_thrust_moment_bound_is_lapse_times_thrust_times_its_offset_over_qbar_s_cbar():
+    """|ΔC_m| per unit ΔV/V ≤ THRUST_LAPSE_MAX · T · |z_T| / (q̄ S c̄), with the larger of the
+    model's and the metadata's thrust-line offsets."""
+    from harness.diagnosis.stepwise_axes import THRUST_LAPSE_MAX, thrust_moment_bound
+    p, trim, _ = _jet_drift_case(0.0)
+    assert thrust_moment_bound(p, trim) == pytest.approx(THRUST_LAPSE_MAX * 2000.0 * 0.3 / (160.0 * 300.0 * 11.32))
+    p.meta["thrust_offset_ft"] = 0.5
+    assert thrust_moment_bound(p, trim) == pytest.approx(THRUST_LAPSE_MAX * 2000.0 * 0.5 / (160.0 * 300.0 * 11.32))
+
+
+@pytest.mark.parametrize("estimate, named", [(0.003, False), (-0.003, False), (0.02, True)])
+def test_a_jet_pitch_drift_without_thrust_is_named_only_beyond_what_the_thrust_could_imitate(estimate, named):
+    """Without a thrust channel a jet's C_m ΔV/V term is offered (its thrust moment is small),
+    and named only two standard errors beyond the bound (0.0022 here); with thrust recorded
+    the rule stays out of the way."""
+    from harness.diagnosis.stepwise_axes import withhold_thrust_drift
+    p, trim, c = _jet_drift_case(estimate)
+    withhold_thrust_drift([c], p, trim)
+    assert c.selected is named
+    assert c.details["thrust_bound"] == pytest.approx(0.0022, abs=1e-4)
+    assert named or "could imitate a C_m drift of up to 0.0022" in c.reason
+    p, trim, c = _jet_drift_case(estimate, raw={"thrust": np.zeros(3)})
+    withhold_thrust_drift([c], p, trim)
+    assert c.selected and "thrust_bound" not in c.details

@@ -19,7 +19,7 @@ from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_par
                                             withhold_offset_of_a_scaled_vane)
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
-                                             stepwise_fits, vane_noise_columns)
+                                             stepwise_fits, vane_noise_columns, withhold_thrust_drift)
 from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
@@ -79,6 +79,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     vane = vane_noise_columns(p, along, slope_of, V0, mismatch, wander_gust)
     step = stepwise_fits(p, has_propeller(aircraft.model), aero, measured, mismatch, delays, vane)
     cands += aero_candidates(step.selections, delays, p.dt, step.shares)
+    if not has_propeller(aircraft.model):
+        withhold_thrust_drift(cands, p, aero.trim)
     if step.pinned is not None:
         cands.append(pinned_shift(step.pinned))
     # the rules that keep a term from being named when something else would imitate it

@@ -17,6 +17,7 @@ from harness.diagnosis.kinematics import PRACTICAL
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from models.constants import SURFACES
 from models.replay import AeroAlong
+from models.trim import TrimPoint
 
 
 def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
@@ -37,7 +38,8 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
     rival = cand.offset_rival(p, mismatch, noise, off) if sel else None
     if rival is not None:  # the mismatch is left whole for the stepwise fits to judge
         sel = False
-        reason = (f"not named: the force mismatch cannot tell it from {rival.parameter} (r = {rival.correlation:+.2f}): "
+        reason = (f"not named: the force mismatch cannot tell it from {rival.parameter} "
+                  f"(r = {rival.correlation:+.2f}): "
                   f"beside it the position stands at t = {rival.t_offset:.1f}, and {rival.parameter} at t = "
                   f"{rival.t_rival:.1f} beside the position; the mismatch is left to the stepwise fits")
     if sel:
@@ -134,7 +136,7 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
                              | ({"reason": t.details["not_offered"]} if "not_offered" in t.details else {})
                              for t in skipped]
-        nuisance = _thrust_nuisance(p, axis, terms)
+        nuisance = _thrust_nuisance(p, axis, terms, propeller)
         if vane and axis in vane:
             nuisance["vane_alpha_noise"] = vane[axis]
         why = NO_THRUST_DRIFT if "thrust_dV" in nuisance else PROPELLER_DRIFT if (axis in cand.LAT and propeller) \
@@ -280,22 +282,60 @@ def shift_mistrim_test(p: Prepared, dx: float, axis: str, selections: dict, nuis
     return CgMeanTest(True, reason, dx_mean, se_mean, bool(pinned), share, explained)
 
 
-def _thrust_nuisance(p: Prepared, axis: str, terms: list) -> dict[str, np.ndarray]:
+def _thrust_nuisance(p: Prepared, axis: str, terms: list, propeller: bool) -> dict[str, np.ndarray]:
     """Columns always in the fit of ``axis`` for what the thrust does outside the model's
-    aerodynamics. Without a thrust channel (thrust held at trim), CX and Cm get the airspeed
-    change: a jet's thrust changes with airspeed at a fixed throttle, in force and, through
-    the thrust line's offset from the c.g. (5.1 in on JSBSim's F-16), in pitching moment; no
-    other term may stand in for it. (With a thrust channel, Eqs. 1 and 4 use it, with the
+    aerodynamics. Without a thrust channel (thrust held at trim), CX gets the airspeed
+    change: a jet's thrust changes with airspeed at a fixed throttle, and no other term may
+    stand in for it. C_m gets it on a propeller aircraft (the slipstream over the tail changes
+    with the thrust); on a jet the thrust's moment is bounded instead
+    (:func:`thrust_moment_bound`, :func:`withhold_thrust_drift`), and a C_m drift well
+    beyond that bound is named. (With a thrust channel, Eqs. 1 and 4 use it, with the
     metadata's ``thrust_offset_ft``.)"""
-    if axis not in ("CX", "Cm") or "thrust" in p.raw:
+    if axis not in ("CX", "Cm") or "thrust" in p.raw or (axis == "Cm" and not propeller):
         return {}
     return {"thrust_dV": t.column for t in terms if t.key == "dV"}
 
 
+def thrust_moment_bound(p: Prepared, trim: TrimPoint) -> float:
+    """The largest C_m change per unit ΔV/V that the thrust's own change with airspeed can
+    put into the mismatch when thrust is not recorded (held at trim):
+    ``THRUST_LAPSE_MAX · T · |z_T| / (q̄ S c̄)``, with T and q̄ at the model's trim and z_T
+    the thrust line's distance from the c.g. (the larger of the metadata's
+    ``thrust_offset_ft`` and the model's own)."""
+    geo = p.meta["geometry"]
+    offset = max(abs(float(p.meta.get("thrust_offset_ft", 0.0))), abs(trim.thrust_offset_ft))
+    return THRUST_LAPSE_MAX * abs(trim.thrust_lbf) * offset / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"])
+
+
+def withhold_thrust_drift(cands: list[Candidate], p: Prepared, trim: TrimPoint) -> None:
+    """Without a thrust channel, a C_m drift (ΔV/V term) on a jet is named only when it stands
+    two standard errors beyond what the thrust's change could imitate
+    (:func:`thrust_moment_bound`); the bound goes into its evidence either way."""
+    if "thrust" in p.raw:
+        return
+    bound = thrust_moment_bound(p, trim)
+    for c in cands:
+        if c.parameter != "Cm_dV" or not c.test.startswith("stepwise"):
+            continue
+        c.details["thrust_bound"] = bound
+        if c.selected and abs(c.estimate) - 2.0 * c.std_error < bound:
+            c.selected = False
+            c.reason = (f"not named: thrust was not recorded, and its change with airspeed, through a thrust line "
+                        f"{max(abs(float(p.meta.get('thrust_offset_ft', 0.0))), abs(trim.thrust_offset_ft)):.2f} ft "
+                        f"from the c.g., could imitate a C_m drift of up to {bound:.2g} per unit ΔV/V")
+
+
+# How fast a jet's thrust may change with airspeed at a fixed throttle, |d ln T / d ln V|, for
+# the bound on its moment (thrust_moment_bound): twice the -1 of constant power (T = P/V, the
+# fastest a propeller's falls); a jet's net thrust, m_dot (V_jet - V) with m_dot rising with
+# the ram pressure, falls more slowly than that.
+THRUST_LAPSE_MAX = 2.0
+
+
 PROPELLER_DRIFT = ("the propeller's torque, P-factor and slipstream change with airspeed at a fixed throttle, "
                    "outside the model's aerodynamic coefficients: a lateral drift term would fit them")
-NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX or Cm cannot be told from the "
-                   "thrust's own change with airspeed (its force, and its moment about the c.g.)")
+NO_THRUST_DRIFT = ("thrust was not recorded (held constant at trim): a drift in CX (or, behind a propeller, in Cm) "
+                   "cannot be told from the thrust's own change with airspeed (its force; its moment and slipstream)")
 
 
 def practical_size(name: str, dt: float) -> float:
