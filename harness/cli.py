@@ -292,11 +292,11 @@ def _add_diagnosis_sweep(sub) -> None:
 def _add_outside_sweep(sub) -> None:
     so = sub.add_parser("outside-sweep", help="score the diagnosis on flight-test-like recordings at other conditions "
                                               "and on a second aircraft (c172x)",
-                        description="Fly about eighty recordings the way a flight-test team's data arrive (surfaces "
+                        description="Fly about 170 cases the way a flight-test team's data arrive (surfaces "
                                     "measured after a second-order actuator, inertial gyros, Gauss-Markov noise on "
-                                    "alpha and beta, 8 significant digits, no h or thrust in some): five F-16 "
-                                    "conditions, two c172x conditions, pitch-only, lateral-only and three-axis "
-                                    "maneuvers, every effect id, nulls and noise-free self-checks (F-16, 737, c172x). "
+                                    "alpha and beta, 8 significant digits, no h or thrust in some): eight F-16 "
+                                    "conditions, four c172x, the 737 and the DHC-6, pitch-only, lateral-only and "
+                                    "three-axis maneuvers, every effect id, nulls and noise-free self-checks. "
                                     "Scores a: right effect and parameter first, b: size within 2 s.e. or 25 %, "
                                     "c: false findings, d: validation RMS -30 %. Writes OUT/sweep.md, OUT/sweep.json "
                                     "and one result per case (a rerun resumes).")

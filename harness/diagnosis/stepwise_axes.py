@@ -296,33 +296,41 @@ def _thrust_nuisance(p: Prepared, axis: str, terms: list, propeller: bool) -> di
     return {"thrust_dV": t.column for t in terms if t.key == "dV"}
 
 
+def thrust_line_offset(p: Prepared, trim: TrimPoint) -> float:
+    """The thrust line's distance from the c.g. (ft): the larger of the metadata's
+    ``thrust_offset_ft`` and the model's own at its trim."""
+    return max(abs(float(p.meta.get("thrust_offset_ft", 0.0))), abs(trim.thrust_offset_ft))
+
+
 def thrust_moment_bound(p: Prepared, trim: TrimPoint) -> float:
     """The largest C_m change per unit ΔV/V that the thrust's own change with airspeed can
     put into the mismatch when thrust is not recorded (held at trim):
     ``THRUST_LAPSE_MAX · T · |z_T| / (q̄ S c̄)``, with T and q̄ at the model's trim and z_T
-    the thrust line's distance from the c.g. (the larger of the metadata's
-    ``thrust_offset_ft`` and the model's own)."""
+    from :func:`thrust_line_offset`."""
     geo = p.meta["geometry"]
-    offset = max(abs(float(p.meta.get("thrust_offset_ft", 0.0))), abs(trim.thrust_offset_ft))
-    return THRUST_LAPSE_MAX * abs(trim.thrust_lbf) * offset / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"])
+    return (THRUST_LAPSE_MAX * abs(trim.thrust_lbf) * thrust_line_offset(p, trim)
+            / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"]))
 
 
 def withhold_thrust_drift(cands: list[Candidate], p: Prepared, trim: TrimPoint) -> None:
     """Without a thrust channel, a C_m drift (ΔV/V term) on a jet is named only when it stands
     two standard errors beyond what the thrust's change could imitate
-    (:func:`thrust_moment_bound`); the bound goes into its evidence either way."""
+    (:func:`thrust_moment_bound`); the bound goes into its evidence and its reason either way
+    (the finding rests on the thrust line the model and metadata give)."""
     if "thrust" in p.raw:
         return
     bound = thrust_moment_bound(p, trim)
+    why = (f"thrust was not recorded, and its change with airspeed, through a thrust line "
+           f"{thrust_line_offset(p, trim):.2f} ft from the c.g., could imitate a C_m drift of up to {bound:.2g} "
+           "per unit ΔV/V")
     for c in cands:
         if c.parameter != "Cm_dV" or not c.test.startswith("stepwise"):
             continue
         c.details["thrust_bound"] = bound
         if c.selected and abs(c.estimate) - 2.0 * c.std_error < bound:
-            c.selected = False
-            c.reason = (f"not named: thrust was not recorded, and its change with airspeed, through a thrust line "
-                        f"{max(abs(float(p.meta.get('thrust_offset_ft', 0.0))), abs(trim.thrust_offset_ft)):.2f} ft "
-                        f"from the c.g., could imitate a C_m drift of up to {bound:.2g} per unit ΔV/V")
+            c.selected, c.reason = False, f"not named: {why}"
+        elif c.selected:
+            c.reason += f"; {why}, under this one by more than two standard errors"
 
 
 # How fast a jet's thrust may change with airspeed at a fixed throttle, |d ln T / d ln V|, for
