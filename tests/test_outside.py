@@ -666,3 +666,24 @@ def test_a_pitch_null_at_a_100_hz_step_names_nothing(tmp_path, seed, parameter, 
     assert [f["effect"] for f in result["findings"]] == ["none"]
     term = next(c for c in result["candidates"] if c["parameter"] == parameter)
     assert abs(term["t"]) >= 5.0 and not term["selected"] and words in term["reason"]
+
+
+def test_a_structural_mode_is_scored_on_the_raw_record_where_it_rings():
+    """Criterion d excepts turbulence only: a structural mode's fit is judged on the affected
+    channel's raw RMS (it rings above the common filter's cutoff, where the filtered record
+    has none of it), every other effect's on the filtered RMS; both sweeps score the mode on q."""
+    from harness.diagnosis.outside_cases import cases
+    from harness.diagnosis.sweep import cases as sweep_cases
+    from harness.diagnosis.sweep import validation_drop
+
+    def finding(effect, before, after):
+        fit = lambda rms, raw: {"validation": {"outputs": {"q": {"rms": rms, "rms_raw": raw}}}}  # noqa: E731
+        return {"effect": effect, "fit_before": fit(*before), "fit_after": fit(*after)}
+    mode = finding("structural_mode", (0.0007, 0.0040), (0.0007, 0.0026))
+    assert validation_drop(mode, "q", True) == (True, [0.0040, 0.0026])
+    small = finding("structural_mode", (0.0007, 0.0040), (0.0007, 0.0030))
+    assert validation_drop(small, "q", True)[0] is False
+    term = finding("coefficient_error", (0.0060, 0.0070), (0.0030, 0.0060))
+    assert validation_drop(term, "q", True) == (True, [0.0060, 0.0030])
+    assert {c.channel for c in cases() if c.expect == "structural_mode"} == {"q"}
+    assert {c.channel for c in sweep_cases() if c.expect == "structural_mode"} == {"q"}

@@ -250,7 +250,7 @@ def cases() -> tuple[OutsideCase, ...]:
     mode, small_mode = StructuralMode(8.0, 0.02, 0.5, 3.0), StructuralMode(7.0, 0.03, 0.3, 2.0)
     for where, kind, m in (("S", "pitch", mode), ("M", "three_axis", mode), ("C2", "pitch", small_mode)):
         out.append(OutsideCase(f"{where}_{kind}_structural_mode_{m.frequency_hz:g}Hz", where, kind, (),
-                               "structural_mode", "mode_frequency_hz", m.frequency_hz, "", mode=m))
+                               "structural_mode", "mode_frequency_hz", m.frequency_hz, "q", mode=m))
     for where, kind, sev in (("M", "pitch", 3), ("H", "lateral", 3), ("S", "three_axis", 4), ("C2", "three_axis", 3)):
         out.append(OutsideCase(f"{where}_{kind}_turbulence_sev{sev}", where, kind, (), "turbulence", "sigma_gust_fps",
                                float("nan"), "", turbulence=Turbulence("dryden", sev, 30.0)))

@@ -133,7 +133,7 @@ def cases() -> tuple[SweepCase, ...]:
                       seed=seed))
     for label, mode in (("8Hz", StructuralMode(8.0, 0.02, 0.5, 3.0)), ("8Hz_small", StructuralMode(8.0, 0.03, 0.15, 1.0)),
                         ("9Hz_small", StructuralMode(9.0, 0.04, 0.06, 0.4))):
-        out.append(_c(f"struct_{label}", None, "structural_mode", "mode_frequency_hz", mode.frequency_hz, "",
+        out.append(_c(f"struct_{label}", None, "structural_mode", "mode_frequency_hz", mode.frequency_hz, "q",
                       mode=mode))
     for label, turb in (("moderate", Turbulence("dryden", 3, 30.0)), ("severe4", Turbulence("dryden", 4, 30.0))):
         out.append(_c(f"turbulence_{label}", None, "turbulence", "sigma_gust_fps", float("nan"), "", turbulence=turb))
@@ -195,8 +195,11 @@ def validation_drop(first: dict, channel: str | None, named: bool) -> tuple[bool
         return None, None
     if "validation" not in first.get("fit_before", {}) or first["effect"] == "none":
         return False, None
-    before = first["fit_before"]["validation"]["outputs"].get(channel, {}).get("rms")
-    after = first["fit_after"]["validation"].get("outputs", {}).get(channel, {}).get("rms")
+    # a structural mode rings above the common filter's cutoff, where the filtered record the
+    # replay is compared with has none of it: its fit is judged on the raw record
+    key = "rms_raw" if first["effect"] == "structural_mode" else "rms"
+    before = first["fit_before"]["validation"]["outputs"].get(channel, {}).get(key)
+    after = first["fit_after"]["validation"].get("outputs", {}).get(channel, {}).get(key)
     if not before or after is None:
         return False, None
     return bool(named and 1.0 - after / before >= BAR_DROP), [before, after]
