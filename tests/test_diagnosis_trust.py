@@ -1383,3 +1383,21 @@ def test_a_jet_pitch_drift_without_thrust_is_named_only_beyond_what_the_thrust_c
     p, trim, c = _jet_drift_case(estimate, raw={"thrust": np.zeros(3)})
     withhold_thrust_drift([c], p, trim)
     assert c.selected and "thrust_bound" not in c.details
+
+
+@pytest.mark.parametrize("name, driven, channels, vane", [
+    ("bias_beta", ("alpha", "q", "de"), ("h",), "beta"),       # a pitch maneuver: β still
+    ("vane_beta_x", ("alpha", "q", "de"), ("h",), "beta"),
+    ("bias_beta", ("beta", "p", "r", "da"), ("h",), None),      # β driven
+    ("bias_alpha", ("beta", "p", "r", "da"), ("h",), None),     # α still, but the flight path records it
+    ("bias_alpha", ("beta", "p", "r", "da"), (), "alpha"),      # α still and no altitude
+    ("bias_q", ("alpha", "q", "de"), (), None)])
+def test_a_still_angle_s_error_is_untestable_where_only_the_airspeed_change_shows_it(name, driven, channels, vane):
+    """steady_vane: a constant error of an angle the maneuver never drove reaches the
+    kinematics only as V̇·b; β always (no ground track), α only without an altitude record."""
+    from types import SimpleNamespace
+    from harness.diagnosis.sensor_rules import steady_vane, steady_vane_reason
+    p = SimpleNamespace(driven=driven, raw={c: None for c in channels})
+    assert steady_vane(name, p) == vane
+    if vane:
+        assert "never drove" in steady_vane_reason(vane) and "V̇·b" in steady_vane_reason(vane)

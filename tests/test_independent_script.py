@@ -277,3 +277,18 @@ def test_an_aerodynamic_reference_point_moved_aft_is_named_as_a_moment_reference
     result = diagnose("f16", rec, tmp_path / "out", val, calibrate=False)
     assert [p for p, _ in _found(result)] == ["dx_moment_reference"]
     assert result["findings"][0]["estimate"] == pytest.approx(0.5, rel=0.1)
+
+
+def test_a_sideslip_bias_is_not_named_from_a_pitch_maneuver(tmp_path):
+    """A c172x pitch-only null (8,000 ft / 200 ft/s, 5° stabilator multisine at 50 Hz): β never
+    moves, so a constant β-vane error reaches the kinematics only as V̇·b in v̇, and the
+    kinematics read 3.1° (t 5.1) from whatever else follows the airspeed there. Not named,
+    and `not_checked` says why."""
+    import jsbsim
+    c172x = str(Path(jsbsim.get_default_root_dir()) / "aircraft" / "c172x" / "c172x.xml")
+    rec = fly(tmp_path / "id.csv", "c172x", 8000.0, 200.0, 133, 50.0, "ms_pitch", amplitude_deg=5.0)
+    result = diagnose(c172x, rec, tmp_path / "out", calibrate=False)
+    assert _found(result) == []
+    bias = next(c for c in result["candidates"] if c["parameter"] == "bias_beta")
+    assert not bias["selected"] and "never drove β" in bias["reason"]
+    assert any("bias_beta" in n["parameters"] and "never drove β" in n["reason"] for n in result["not_checked"])

@@ -16,7 +16,7 @@ from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, 
                                              withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
                                             kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
-                                            withhold_offset_of_a_scaled_vane)
+                                            steady_vane, withhold_offset_of_a_scaled_vane)
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns, withhold_thrust_drift)
@@ -55,7 +55,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     plausible = kinematics_plausible(kin, V0, p)
     contested = contested_parameters(kin, p)
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
-                     if n not in contested}
+                     if n not in contested and steady_vane(n, p) is None}
     recorded, p = p, corrected_recording(p, kin, sensor_values)
     # 2. the model along the measured states
     along = model_along(p, aircraft, ic)

@@ -43,8 +43,38 @@ def undriven_vane(name: str, p: Prepared) -> bool:
     a β bias of −25° (t 3.3, a T-6) and 18° (t 3.0, the F-16 at 427 ft/s) "implausible", which
     voided every sensor test of the maneuver (the α bias of probe 21 was set apart as not
     confirmed: its validation maneuver's means test never ran)."""
-    vane = next((v for v in ("alpha", "beta") if name.endswith(f"_{v}") or name.startswith(f"vane_{v}_")), None)
+    vane = _vane_of(name)
     return vane is not None and vane not in p.driven
+
+
+def _vane_of(name: str) -> str | None:
+    return next((v for v in ("alpha", "beta") if name.endswith(f"_{v}") or name.startswith(f"vane_{v}_")), None)
+
+
+def steady_vane(name: str, p: Prepared) -> str | None:
+    """The vane ('alpha' or 'beta') whose error kinematic parameter ``name`` is, when the
+    recording never drove that angle (:func:`undriven_vane`) and no other kinematic channel
+    records it; else None. A constant error of a still angle reaches the kinematics only as
+    V̇·b (in v̇ for β, v = V sin β; in ẇ for α), and whatever else in that equation follows
+    the airspeed's change reads as one. Nothing records the sideslip besides (no ground
+    track); a still α's error also shows in the flight path (θ − α against the altitude's
+    rate), so α counts only without an ``h`` channel. Such an estimate is not named from the
+    kinematics (:func:`steady_vane_reason`): a c172x pitch-only null (8,000 ft / 200 ft/s, 5°
+    stabilator multisine, the independent script's seed 133) gave a β bias of 3.1° at t 5.1.
+    The coefficient means along the vane (:func:`sensor_naming.name_vane_bias_from_means`)
+    are another test, and stay."""
+    vane = _vane_of(name)
+    if vane is None or vane in p.driven or (vane == "alpha" and "h" in p.raw):
+        return None
+    return vane
+
+
+def steady_vane_reason(vane: str) -> str:
+    """Why an error of the still ``vane`` is not named (:func:`steady_vane`)."""
+    angle, eq = ("β", "v̇") if vane == "beta" else ("α", "ẇ")
+    return (f"the maneuver never drove {angle}" + (" and no altitude was recorded" if vane == "alpha" else "")
+            + f": a constant {angle}-vane error shows in the kinematics only through the airspeed's changes "
+            f"(V̇·b in {eq}), which anything else in that equation that follows the airspeed imitates")
 
 
 def applied_sensor_values(kin: KinematicResult, turbulent: bool, plausible: bool,
@@ -71,11 +101,13 @@ def sensor_verdict(name: str, est: float, se: float, entered: bool, kin: Kinemat
     precise = se <= max(0.5 * practical_size(name, p.dt), 0.25 * abs(est))
     # the estimate itself too (an undriven vane's is left out of the kinematics' verdict)
     plausible = plausible and is_plausible(name, est, float(np.mean(p.smooth["V"])))
-    sel = entered and practical and precise and not turbulent and not gusty and plausible
+    steady = steady_vane(name, p)
+    sel = entered and practical and precise and not turbulent and not gusty and plausible and steady is None
     reason = ("significant, practical and precise" if sel else "below the entry t" if not entered else
               "within the instrument noise budget (practical size)" if not practical else
               "poorly determined" if not precise else NOT_IN_TURBULENCE if turbulent else
-              f"not applied: {gusty}" if gusty else IMPLAUSIBLE)
+              f"not applied: {gusty}" if gusty else IMPLAUSIBLE if not plausible else
+              f"not named: {steady_vane_reason(steady)}")
     return sel, reason
 
 

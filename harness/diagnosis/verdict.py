@@ -12,6 +12,7 @@ from harness.diagnosis.gust_rules import vane_wander
 from harness.diagnosis.kinematics import time_base_problem
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
+from harness.diagnosis.sensor_rules import steady_vane, steady_vane_reason
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 
@@ -339,6 +340,9 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
     for s in SURFACES:
         if s in p.raw and s not in p.driven:
             grouped.setdefault(("control_delay", undriven_reason(p, [s])), []).append(f"tau_{s}")
+    for vane in ("alpha", "beta"):
+        if vane in p.raw and steady_vane(f"bias_{vane}", p):
+            grouped.setdefault(("sensor_bias", steady_vane_reason(vane)), []).append(f"bias_{vane}")
     for name, why in sorted(a.kinematic.dropped.items()):  # in a fixed order, run to run
         kind = name.split("_", 1)[0]
         effect = {"scale": "sensor_scale", "skew": "sensor_time_skew"}.get(kind, "sensor_" + kind)
