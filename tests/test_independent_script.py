@@ -292,3 +292,22 @@ def test_a_sideslip_bias_is_not_named_from_a_pitch_maneuver(tmp_path):
     bias = next(c for c in result["candidates"] if c["parameter"] == "bias_beta")
     assert not bias["selected"] and "never drove β" in bias["reason"]
     assert any("bias_beta" in n["parameters"] and "never drove β" in n["reason"] for n in result["not_checked"])
+
+
+def test_an_alpha_scale_is_not_read_as_a_power_of_alpha(tmp_path):
+    """A 10 % α-vane scale written into a c172x pitch maneuver (6,000 ft / 190 ft/s, 5°
+    stabilator multisine, doublet validation, both through the same vane): the model evaluated
+    along the scaled vane carries its nonlinear slope times 0.1 α, which a C_X α² fitted
+    (−0.73, confirmed by the validation doublets). The kinematics suspect the scale (t 5.6), as
+    for the C_Z,α change beside it: a term in α's powers is asked of the α sensor's suspected
+    error too, and is not named."""
+    import jsbsim
+    c172x = str(Path(jsbsim.get_default_root_dir()) / "aircraft" / "c172x" / "c172x.xml")
+    rec = fly(tmp_path / "id.csv", "c172x", 6000.0, 190.0, 302, 50.0, "ms_pitch", amplitude_deg=5.0)
+    val = fly(tmp_path / "val.csv", "c172x", 6000.0, 190.0, 303, 50.0, "dbl3", amplitude_deg=5.0)
+    for path in (rec, val):
+        _sensor_error(path, "alpha_rad", lambda t, x: 1.1 * x)
+    result = diagnose(c172x, rec, tmp_path / "out", val, calibrate=False)
+    assert {p for p, _ in _found(result)} <= {"scale_alpha"}
+    power = next(c for c in result["candidates"] if c["parameter"] == "CX_alpha2")
+    assert not power["selected"] and "scale_alpha" in power["reason"], power["reason"]

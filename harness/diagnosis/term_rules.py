@@ -614,8 +614,10 @@ def regressor_channel(c: Candidate) -> str | None:
     q), and α for an α̇ term. The model is evaluated along the α vane, so an error of the vane
     (a lag: −τα̇ times the model's slope; a vane ahead: −x·q/V) reaches the mismatch as a
     term in α̇: a c172x recording whose α was 80 ms late named a C_Z,α̇ of −55 that the α
-    vane's suspected error imitates."""
-    if c.effect == "unsteady_alphadot":
+    vane's suspected error imitates. Likewise α's powers: the model's nonlinear slope along a
+    scaled vane puts α·Δα into the mismatch (a c172x pitch maneuver with a 10 % α scale named
+    a C_X α² of −0.73)."""
+    if c.effect in ("unsteady_alphadot", "nonlinear_alpha"):
         return "alpha"
     return cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
 
@@ -715,7 +717,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     for c in cands:
         if c.selected and c.effect == "control_delay":
             _withhold_skewed_delay(c, kin)
-        if not (c.selected and c.effect in ("coefficient_error", "unsteady_alphadot")):
+        if not (c.selected and c.effect in ("coefficient_error", "unsteady_alphadot", "nonlinear_alpha")):
             continue
         channel = regressor_channel(c)
         found = next((r for r in rivals_of(channel) if explains(c, *r)), None)
