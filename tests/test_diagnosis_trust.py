@@ -154,6 +154,27 @@ def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
     assert id(strong) not in checks
 
 
+def test_a_term_the_calibration_sizes_with_the_other_sign_is_withdrawn():
+    """augmented.unsupported_in_the_loop: a coefficient change the equation error puts at +0.96
+    and the calibration, clearly away from zero, at −0.16 ± 0.02 (an α-vane scale read as a
+    C_Z,α change) is not one the aircraft flies: withdrawn, the reason saying so; the same
+    sign at another size stands."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.augmented import unsupported_in_the_loop
+
+    def cand(change):
+        return Candidate("coefficient_error", "lon", "CZ", "CZ_alpha", -9.9 + change, 0.09, 10.6, 0.6, "per rad",
+                         "stepwise on the CZ mismatch", selected=True, reason="entered", details={"change": change})
+
+    reversed_, agreeing = cand(0.96), cand(0.96)
+    checks = {}
+    assert unsupported_in_the_loop([reversed_], {"used": True, "findings": {"CZ_alpha": {
+        "size": -0.163, "std_error": 0.023}}}, checks) == [reversed_]
+    assert "of the opposite sign" in checks[id(reversed_)]["reason"]
+    assert unsupported_in_the_loop([agreeing], {"used": True, "findings": {"CZ_alpha": {
+        "size": 0.70, "std_error": 0.023}}}, checks) == []
+
+
 def test_the_model_mass_assumption_names_how_far_the_recording_is():
     """verdict._mass_difference: the recording's mass and inertias against the model's, named
     when 2 % or more apart (the coefficients use the recording's, the replays the model's)."""
