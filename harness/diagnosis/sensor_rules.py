@@ -64,7 +64,7 @@ def steady_vane(name: str, p: Prepared) -> str | None:
     The coefficient means along the vane (:func:`sensor_naming.name_vane_bias_from_means`)
     are another test, and stay."""
     vane = _vane_of(name)
-    if vane is None or vane in p.driven or (vane == "alpha" and "h" in p.raw):
+    if not undriven_vane(name, p) or (vane == "alpha" and "h" in p.raw):
         return None
     return vane
 
