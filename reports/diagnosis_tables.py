@@ -203,7 +203,9 @@ def fit_table(maneuver: str, before: Mapping, after: Mapping) -> Table | None:
     marks = tuple((i, "after", css) for i, (_, _, m, b, a) in enumerate(rows)
                   if (css := _change_css(m, b, a)))
     return Table(f"Before and after, {maneuver}", frame,
-                 "Outputs against the smoothed recording (RMS, Theil's U), the coefficient residual (RMS, "
+                 "Outputs against the smoothed recording (RMS, Theil's U; a modelled structural mode's band "
+                 "put back in the outputs it rings in, raw RMS against the record itself), the coefficient "
+                 "residual (RMS, "
                  "PSE) and its whiteness (share of autocorrelation lags inside the 95 % bounds, Ljung-Box "
                  f"z). Green: better after by {100 * IMPROVED:.0f} % or more; red: worse.", marks)
 

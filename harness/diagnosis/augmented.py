@@ -18,6 +18,7 @@ from harness.diagnosis.along import interior
 from harness.diagnosis.analysis import analyse
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.fits import coefficient_fit, output_fit
+from harness.diagnosis.mode_model import driven_modes, mode_outputs, with_mode_band
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
 from harness.diagnosis.validation import after_mismatch
@@ -169,10 +170,13 @@ def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect
     nan = {c: np.full(p.n, np.nan) for c in CHANNEL_COLUMNS}
     sim_b = before.outputs if before.outputs is not None else nan
     sim_a = after.outputs if after.outputs is not None else nan
-    fit_b = {"outputs": output_fit(p.smooth, p.raw, sim_b, OUTPUTS, inner) if before_failed is None else {},
+    modes = driven_modes(findings or [])
+    sim_a = _with_modes(sim_a, p, modes)
+    smooth = with_mode_band(p, p.smooth, modes)
+    fit_b = {"outputs": output_fit(smooth, p.raw, sim_b, OUTPUTS, inner) if before_failed is None else {},
              "coefficients": coefficient_fit(before_mm, before_mm, {}, inner)}
     raw_after = _mode_notched(p, findings or [])
-    fit_a = {"outputs": output_fit(p.smooth, raw_after, sim_a, OUTPUTS, inner) if diverged is None else {},
+    fit_a = {"outputs": output_fit(smooth, raw_after, sim_a, OUTPUTS, inner) if diverged is None else {},
              "coefficients": coefficient_fit(before_mm, after_mm, n_terms, inner)}
     fit_b["surface_levels_deg"] = {k: float(np.degrees(v)) for k, v in before.levels.items()}
     fit_a["surface_levels_deg"] = {k: float(np.degrees(v)) for k, v in after.levels.items()}
@@ -203,12 +207,26 @@ def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect
 MODE_NOTCH_Q = 8.0
 
 
+def _with_modes(sim: dict[str, np.ndarray], p: Prepared, modes: list) -> dict[str, np.ndarray]:
+    """The replay's outputs with each driven mode's response (:mod:`harness.diagnosis.mode_model`)
+    added to the outputs it rings in."""
+    if not modes:
+        return sim
+    out = dict(sim)
+    for m in modes:
+        for c, y in mode_outputs(m, p).items():
+            if c in out:
+                out[c] = out[c] + y
+    return out
+
+
 def _mode_notched(p: Prepared, findings: list[Candidate]) -> dict[str, np.ndarray]:
     """The recorded channels as the augmented sensor model sees them: a structural mode found
-    becomes a notch (scipy.signal.iirnotch at its frequency, zero phase) in every rate and
-    acceleration channel, so the raw fit after shows what the mode term removes. Returns
-    ``p.raw`` unchanged when no mode was found."""
-    modes = [f for f in findings if f.effect == "structural_mode"]
+    that no recorded surface's response explains (no ``mode_model``) becomes a notch
+    (scipy.signal.iirnotch at its frequency, zero phase) in every rate and acceleration
+    channel, so the raw fit after shows what the mode term removes. Returns ``p.raw``
+    unchanged when there is no such mode."""
+    modes = [f for f in findings if f.effect == "structural_mode" and not f.details.get("mode_model")]
     if not modes:
         return p.raw
     out = dict(p.raw)
@@ -375,7 +393,15 @@ def sensor_models(findings: list[Candidate]) -> list[dict]:
     structural mode's notch and the turbulence's reconstructed gusts."""
     out = []
     for f in findings:
-        if f.effect == "structural_mode":
+        if f.effect == "structural_mode" and f.details.get("mode_model"):
+            m = f.details["mode_model"]
+            out.append({"effect": "structural_mode", **m,
+                        "model": f"second-order mode driven by {m['surface']} (natural frequency "
+                                 f"{m['frequency_hz']:.3g} Hz, damping {m['damping']:.3g}), added to "
+                                 f"{', '.join(m['gains'])}: gains of "
+                                 "s²H(s)u/ω² and sH(s)u/ω, H = ω²/(s² + 2ζωs + ω²), u the surface's Wiener estimate "
+                                 "(harness/diagnosis/mode_model.py)"})
+        elif f.effect == "structural_mode":
             out.append({"effect": "structural_mode", "frequency_hz": float(f.estimate), "notch_q": MODE_NOTCH_Q,
                         "channels": [c for c in MODE_CHANNELS], "model": "second-order notch (scipy.signal.iirnotch), "
                         "zero phase, on the rate and acceleration channels"})

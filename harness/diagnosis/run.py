@@ -16,6 +16,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
                                          write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.limits import detection_limits
+from harness.diagnosis.mode_model import attach_mode_models
 from harness.diagnosis.prepare import instruments_at_cg, prepare
 from harness.diagnosis.reference_point import choose_reference_point
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
@@ -237,6 +238,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         pv, av, befores["validation"] = (pending.result() if pending is not None else
                                          analysed(recs["validation"], "validation", aircraft))
     findings, unconfirmed, checks = _checked(a, av)
+    attach_mode_models(findings, {"identification": p} | ({"validation": pv} if av is not None else {}))
     modelled = list(findings)
     added = terms_of(modelled, a.applied)
     timing = {"analysis": time.perf_counter() - t0}

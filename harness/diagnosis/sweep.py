@@ -195,11 +195,10 @@ def validation_drop(first: dict, channel: str | None, named: bool) -> tuple[bool
         return None, None
     if "validation" not in first.get("fit_before", {}) or first["effect"] == "none":
         return False, None
-    # a structural mode rings above the common filter's cutoff, where the filtered record the
-    # replay is compared with has none of it: its fit is judged on the raw record
-    key = "rms_raw" if first["effect"] == "structural_mode" else "rms"
-    before = first["fit_before"]["validation"]["outputs"].get(channel, {}).get(key)
-    after = first["fit_after"]["validation"].get("outputs", {}).get(channel, {}).get(key)
+    # a structural mode's fit is judged against the smoothed record with the mode's band put
+    # back (mode_model.with_mode_band), as the diagnosis reports it
+    before = first["fit_before"]["validation"]["outputs"].get(channel, {}).get("rms")
+    after = first["fit_after"]["validation"].get("outputs", {}).get(channel, {}).get("rms")
     if not before or after is None:
         return False, None
     return bool(named and 1.0 - after / before >= BAR_DROP), [before, after]

@@ -38,8 +38,8 @@ EXPLAIN = {
                    "other channels disagree with it by a constant.",
     "sensor_scale": "The {channel} sensor has a scale-factor error k = {estimate:.3g} ± {std_error:.2g}.",
     "sensor_time_skew": "The {channel} channel lags the others by {estimate:.3f} ± {std_error:.3f} s.",
-    "structural_mode": "A narrow spectral peak at {estimate:.2f} Hz in {channel} points to an unmodelled flexible "
-                       "mode.",
+    "structural_mode": "A narrow spectral peak in {channel} points to an unmodelled flexible mode at {estimate:.2f} "
+                       "Hz.",
     "turbulence": "The air-relative and inertial velocities disagree broadband (gust RMS about {estimate:.1f} ft/s): "
                   "the flight was in turbulence, which no deterministic model term can replay.",
 }
@@ -195,6 +195,25 @@ EXPLAIN_VANE_OFFSET = ("The {channel} vane is not at the c.g.: it reads the flow
 _VANE_ROTATION = {"alpha": "−x·q/V", "beta": "x·r/V"}
 
 
+def _mode_model_text(c: Candidate) -> str:
+    """How a structural mode is modelled (``details['mode_model']``, harness.diagnosis.mode_model)."""
+    if c.effect != "structural_mode" or "mode_model" not in c.details:
+        return ""
+    m = c.details["mode_model"]
+    if not m:
+        return (" No recorded surface's response explains it (something unrecorded rings it): the augmented "
+                "sensor model notches it out of the rate and acceleration channels.")
+    peak = c.details.get("spectral_peak_hz", [float("nan")])[0]
+    text = (f" Fitted as a second-order mode driven by {m['surface']}: natural frequency {m['frequency_hz']:.2f} ± "
+            f"{m['std_error_hz']:.2f} Hz (the spectral peak, where the resonance meets the input's spectrum, lies at "
+            f"{peak:.2f} Hz), damping ratio {m['damping']:.3f}, ringing in {', '.join(m['gains'])}; the augmented "
+            "model adds it to those outputs.")
+    if m["fitted_on"] == "validation":
+        text += (" The identification maneuver does not ring it well enough to fit, so it was fitted on the "
+                 "validation maneuver: the validation fit after is a fit there, not a prediction.")
+    return text
+
+
 def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = None) -> dict:
     fmt = {"axis": c.axis, "channel": c.channel, "parameter": c.parameter, "estimate": c.estimate,
            "std_error": c.std_error, "units": c.units, "model_value": c.details.get("model_value", float("nan"))}
@@ -225,6 +244,7 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     elif both:  # named on the two maneuvers
         text += (f" The identification maneuver rings it too weakly to name alone (p = {both['identification_p']:.2g} "
                  f"at that frequency); the validation maneuver's peak (p = {both['validation_p']:.2g}) names it.")
+    text += _mode_model_text(c)
     if c.details.get("not_ruled_out"):  # an assumption it rests on (term_rules: a skewed delay, an untested coupling)
         text += f" Caveat: {c.details['not_ruled_out']}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}

@@ -1,0 +1,279 @@
+"""A structural mode as a second-order response to a recorded surface, added to the outputs
+it rings in: the model the augmented replay predicts the validation maneuver's mode with.
+
+The flexible coordinate η of a lightly damped mode driven by a surface u obeys
+η̈ + 2ζω η̇ + ω² η = ω² u (ω = 2π f). A gyro sees the mode's rate, an accelerometer its
+acceleration, so each output rings as a combination of the two responses
+
+    r_acc = s² H(s) u / ω²,   r_rate = s H(s) u / ω,   H(s) = ω² / (s² + 2ζωs + ω²),
+
+both of which vanish at low frequency (the rigid-body band the aerodynamics own). Their gains
+are fitted, per output, to what the recording's common filter leaves of it (its content
+above the rigid-body band), with f and ζ found by variable projection (the gains solved
+linearly for each trial f, ζ)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage, optimize, signal, stats
+
+from harness.diagnosis.prepare import Prepared, interior_slice
+from harness.diagnosis.spectra import MODE_CHANNELS, MODE_DRIVERS
+
+# The damping ratios tried before refinement (structural modes: 0.5-20 % of critical).
+DAMPING_GRID = np.geomspace(0.005, 0.2, 10)
+DAMPING_BOUNDS = (0.002, 0.5)  # the refinement's limits
+# The frequencies tried about the spectral peak, as a share of it either side (a mode rung by
+# steps peaks a few tenths of a hertz from its natural frequency, spectra._refine).
+FREQUENCY_SPAN = 0.12
+# An output's pair of mode gains enters when their F statistic beats noise at this level
+# (the structural-mode peak's own level, spectra.FISHER_P).
+GAIN_P = 1e-6
+# Neighbouring Welch ordinates averaged for the Wiener gain (2.5 Hz with 2 s segments).
+WIENER_BINS = 5
+# A fit is a model of the mode when its damping is at most this (a lightly damped mode; a
+# fit that runs to heavy damping has found broadband noise), its frequency within
+# FREQUENCY_SPAN of the spectral peak, and it explains at least MIN_EXPLAINED of the band's
+# power in the channel the peak is in.
+MAX_DAMPING = 0.2
+MIN_EXPLAINED = 0.3
+# Half-width of the band a mode's fit is judged in: at least this, or two half-power
+# bandwidths (2ζf each) of the fitted mode.
+BAND_MIN_HALF_WIDTH_HZ = 0.5
+
+
+@dataclass(frozen=True)
+class DrivenMode:
+    """A structural mode fitted as the response to ``surface``: natural frequency (Hz) and its
+    standard error, damping ratio, and per output the gains of (r_acc, r_rate) in the output's
+    unit per rad of surface."""
+
+    frequency_hz: float
+    std_error_hz: float
+    damping: float
+    surface: str
+    gains: dict[str, tuple[float, float]] = field(default_factory=dict)
+    explained: dict[str, float] = field(default_factory=dict)  # share of the band's power the fit explains
+
+    def as_dict(self) -> dict:
+        return {"frequency_hz": self.frequency_hz, "std_error_hz": self.std_error_hz, "damping": self.damping,
+                "surface": self.surface, "gains": {c: list(g) for c, g in self.gains.items()},
+                "explained_in_band": dict(self.explained)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "DrivenMode":
+        return cls(d["frequency_hz"], d["std_error_hz"], d["damping"], d["surface"],
+                   {c: tuple(g) for c, g in d["gains"].items()}, dict(d.get("explained_in_band", {})))
+
+    def band_hz(self) -> tuple[float, float]:
+        """The band the mode's fit is judged in (:data:`BAND_MIN_HALF_WIDTH_HZ`)."""
+        half = max(BAND_MIN_HALF_WIDTH_HZ, 4.0 * self.damping * self.frequency_hz)
+        return self.frequency_hz - half, self.frequency_hz + half
+
+
+def mode_responses(u: np.ndarray, dt: float, frequency_hz: float, damping: float) -> np.ndarray:
+    """(r_acc, r_rate) of the module docstring for the surface history ``u`` (rad; taken from
+    its first value), each a column: the continuous transfer functions discretised with a
+    first-order hold (scipy.signal.cont2discrete), which treats ``u`` as piecewise linear."""
+    w = 2.0 * np.pi * frequency_hz
+    den = [1.0, 2.0 * damping * w, w * w]
+    x = np.asarray(u, dtype=float) - float(u[0])
+    out = []
+    for num in ([1.0, 0.0, 0.0], [w, 0.0]):
+        b, a, _ = signal.cont2discrete((num, den), dt, method="foh")
+        out.append(signal.lfilter(np.ravel(b), a, x))
+    return np.column_stack(out)
+
+
+def white_noise_std(x: np.ndarray) -> float:
+    """The standard deviation of a record's white noise from its fourth differences: robustly
+    (median absolute deviation / 0.6745), and with their variance 70 σ² for white noise
+    (the sum of the squared binomial coefficients, C(8, 4)). A fourth difference passes a
+    2 Hz motion at 50 samples/s at 0.4 % of its amplitude and puts a step's edge into four
+    samples only, so neither the maneuver's motion nor the sharp edges of a step input (whose
+    spectrum can stand above the noise up to Nyquist) are counted as noise."""
+    d = np.diff(np.asarray(x, dtype=float), 4)
+    return float(np.median(np.abs(d - np.median(d))) / 0.6745 / np.sqrt(70.0))
+
+
+def wiener_surface(u: np.ndarray, dt: float, segment_s: float = 2.0) -> np.ndarray:
+    """The surface history's best estimate from its record: each Fourier coefficient scaled by
+    the share of the record's power there that is signal, G(f) = max(P(f) − N, 0)/P(f) (Wiener
+    1949), P the Welch spectrum (Hann, ``segment_s`` segments) averaged over
+    :data:`WIENER_BINS` neighbouring ordinates (its scatter would otherwise pass a fifth of
+    the noise) and interpolated to the record's frequencies, N the one-sided density of the
+    sensor's white noise (:func:`white_noise_std`). A mode's resonance rings the sensor noise
+    of a surface as loudly as its motion near the mode (0.05 deg of potentiometer noise on a
+    2 deg doublet, an 8 Hz mode at ζ 0.02): a response built on the raw record would fit that ringing's share
+    as missing gain; built on this estimate its gains are unbiased (its error is uncorrelated
+    with it)."""
+    x = np.asarray(u, dtype=float)
+    nper = min(int(round(segment_s / dt)), x.size)
+    f, P = signal.welch(x, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper // 2, detrend="linear")
+    P = ndimage.uniform_filter1d(P, WIENER_BINS, mode="nearest")
+    N = 2.0 * white_noise_std(x) ** 2 * dt  # the one-sided density of white noise
+    G = np.clip(1.0 - N / np.maximum(P, 1e-300), 0.0, 1.0)
+    fx = np.fft.rfftfreq(x.size, dt)
+    m = float(np.mean(x))
+    return np.fft.irfft(np.fft.rfft(x - m) * np.interp(fx, f, G), n=x.size) + m
+
+
+def _fit_band(peak_hz: float) -> tuple[float, float]:
+    """The band a mode is fitted in: the frequencies searched (:data:`FREQUENCY_SPAN` twice
+    over, either side of the peak) and :data:`BAND_MIN_HALF_WIDTH_HZ` beyond. Outside it the
+    record holds the rigid-body response to the input's edges, which the responses would
+    otherwise be fitted to as well."""
+    return (max(peak_hz * (1.0 - 2.0 * FREQUENCY_SPAN) - BAND_MIN_HALF_WIDTH_HZ, 0.0),
+            peak_hz * (1.0 + 2.0 * FREQUENCY_SPAN) + BAND_MIN_HALF_WIDTH_HZ)
+
+
+def _in_band(x: np.ndarray, dt: float, band: tuple[float, float]) -> np.ndarray:
+    """:func:`band_part` of each column."""
+    return np.column_stack([band_part(x[:, j], dt, band) for j in range(x.shape[1])])
+
+
+def _sse(y: np.ndarray, u: np.ndarray, dt: float, f: float, z: float, band: tuple[float, float],
+         inner: slice) -> float:
+    R = _in_band(mode_responses(u, dt, f, z), dt, band)[inner]
+    g, *_ = np.linalg.lstsq(R, y, rcond=None)
+    return float(np.sum((y - R @ g) ** 2))
+
+
+def band_part(x: np.ndarray, dt: float, band_hz: tuple[float, float]) -> np.ndarray:
+    """``x``'s content within ``band_hz`` (zero phase: its Fourier coefficients outside are set
+    to zero, the linear trend removed first, so the record's ends do not leak into the band)."""
+    x = signal.detrend(np.asarray(x, dtype=float))
+    X = np.fft.rfft(x)
+    f = np.fft.rfftfreq(len(x), dt)
+    X[(f < band_hz[0]) | (f > band_hz[1])] = 0.0
+    return np.fft.irfft(X, n=len(x))
+
+
+def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float) -> DrivenMode | None:
+    """The mode a spectral peak at ``frequency_hz`` in ``channel`` points to, fitted as the
+    response to the surface that drives that channel (:data:`spectra.MODE_DRIVERS`) and
+    explains most of it, within :func:`_fit_band`; None when no recorded surface's response
+    explains it (p ≥ :data:`GAIN_P`): a mode rung by something the recording lacks
+    (turbulence, an engine) keeps the sensor model's notch."""
+    inner = interior_slice(p.n, p.dt)
+    surfaces = [s for s in MODE_DRIVERS.get(channel, ()) if s in p.raw and np.ptp(p.raw[s]) > 0]
+    if channel not in p.raw or not surfaces or not 0.0 < frequency_hz < 0.45 / p.dt:
+        return None
+    band = _fit_band(frequency_hz)
+    n_eff = 2 * int(np.count_nonzero((np.fft.rfftfreq(p.n, p.dt) >= band[0])
+                                     & (np.fft.rfftfreq(p.n, p.dt) <= band[1])))
+    y = band_part(p.raw[channel], p.dt, band)[inner]
+    drive = {s: wiener_surface(p.raw[s], p.dt) for s in surfaces}
+
+    def sse(s: str, f: float, z: float) -> float:
+        return _sse(y, drive[s], p.dt, f, z, band, inner)
+
+    best = min((sse(s, f, z), s, f, z) for s in surfaces
+               for f in frequency_hz * (1.0 + np.linspace(-FREQUENCY_SPAN, FREQUENCY_SPAN, 13))
+               for z in DAMPING_GRID)
+    _, s, f0, z0 = best
+    res = optimize.minimize(lambda v: sse(s, v[0], float(np.exp(v[1]))), [f0, np.log(z0)], method="Nelder-Mead",
+                            bounds=[(frequency_hz * (1.0 - 2.0 * FREQUENCY_SPAN),
+                                     frequency_hz * (1.0 + 2.0 * FREQUENCY_SPAN)),
+                                    (np.log(DAMPING_BOUNDS[0]), np.log(DAMPING_BOUNDS[1]))],
+                            options={"xatol": 1e-4, "fatol": 1e-12 * float(y @ y), "maxiter": 200})
+    f, z = float(res.x[0]), float(np.exp(res.x[1]))
+    R = _in_band(mode_responses(drive[s], p.dt, f, z), p.dt, band)[inner]
+    se_f = _frequency_se(lambda ff: sse(s, ff, z), f, n_eff)
+    gains, explained = {}, {}
+    judged = DrivenMode(f, se_f, z, s).band_hz()
+    for c in MODE_CHANNELS:
+        if c not in p.raw:
+            continue
+        yc = band_part(p.raw[c], p.dt, band)[inner]
+        g, pv = _gain_test(R, yc, n_eff)
+        if pv < GAIN_P:
+            gains[c] = (float(g[0]), float(g[1]))
+            yb = band_part(p.raw[c], p.dt, judged)[inner]
+            fit = band_part(R @ g, p.dt, judged)
+            explained[c] = float(1.0 - np.sum((yb - fit) ** 2) / max(float(yb @ yb), 1e-300))
+    if channel not in gains:
+        return None
+    return DrivenMode(f, se_f, z, s, gains, explained)
+
+
+def _gain_test(R: np.ndarray, y: np.ndarray, n_eff: int) -> tuple[np.ndarray, float]:
+    """Least-squares gains of the band-limited ``y`` on the two responses and the F test's p
+    (both zero), with the ``n_eff`` degrees of freedom the band holds (two per Fourier
+    ordinate), not one per sample."""
+    g, *_ = np.linalg.lstsq(R, y, rcond=None)
+    e = y - R @ g
+    k = R.shape[1]
+    F = float((R @ g) @ (R @ g)) / k / max(float(e @ e) / max(n_eff - k, 1), 1e-300)
+    return g, float(stats.f.sf(F, k, max(n_eff - k, 1)))
+
+
+def _frequency_se(sse, f: float, n_eff: int) -> float:
+    """Standard error of the natural frequency from the curvature of the residual sum of
+    squares ``sse(f)`` (variable projection: the gains re-solved), the band-limited residual
+    white within the band (``n_eff`` degrees of freedom): var f = 2 (SSE/(n_eff − 4)) /
+    (∂²SSE/∂f²)."""
+    h = 1e-3 * f
+    e0, ep, em = sse(f), sse(f + h), sse(f - h)
+    curv = (ep - 2.0 * e0 + em) / (h * h)
+    return float(np.sqrt(2.0 * e0 / max(n_eff - 4, 1) / curv)) if curv > 0 else float("nan")
+
+
+def mode_outputs(mode: DrivenMode, p: Prepared) -> dict[str, np.ndarray]:
+    """The mode's contribution to each output it rings in, over maneuver ``p`` (from its
+    recorded surface, :func:`wiener_surface`); empty when ``p`` does not record that surface."""
+    if mode.surface not in p.raw:
+        return {}
+    R = mode_responses(wiener_surface(p.raw[mode.surface], p.dt), p.dt, mode.frequency_hz, mode.damping)
+    return {c: R @ np.asarray(g) for c, g in mode.gains.items()}
+
+
+def acceptable(mode: DrivenMode | None, peak_hz: float, channel: str) -> bool:
+    """Whether a fit is a model of the mode a spectral peak at ``peak_hz`` in ``channel``
+    points to (:data:`MAX_DAMPING`, :data:`FREQUENCY_SPAN`, :data:`MIN_EXPLAINED`)."""
+    return (mode is not None and mode.damping <= MAX_DAMPING
+            and abs(mode.frequency_hz - peak_hz) <= FREQUENCY_SPAN * peak_hz
+            and mode.explained.get(channel, 0.0) >= MIN_EXPLAINED)
+
+
+def attach_mode_models(findings: list, maneuvers: dict) -> None:
+    """Fit each structural-mode finding as a driven mode (:func:`fit_driven_mode`), on the
+    identification maneuver or, when its input does not ring the mode well enough to fit
+    (:func:`acceptable`), on the validation maneuver (then the validation's fit after is a
+    fit, not a prediction: ``fitted_on`` says which). The fit goes into the finding's
+    ``details['mode_model']`` (None: no recorded surface's response explains the mode, and
+    the sensor model's notch stands for it). A fitted mode's natural frequency becomes the
+    finding's estimate (the spectral peak, where the resonance meets the input's spectrum,
+    is kept in ``details['spectral_peak_hz']``). ``maneuvers``: role -> Prepared."""
+    for f in findings:
+        if f.effect != "structural_mode":
+            continue
+        f.details["mode_model"] = None
+        for role in ("identification", "validation"):
+            p = maneuvers.get(role)
+            mode = fit_driven_mode(p, f.channel, f.estimate) if p is not None else None
+            if acceptable(mode, f.estimate, f.channel):
+                f.details["mode_model"] = mode.as_dict() | {"fitted_on": role}
+                f.details["spectral_peak_hz"] = [f.estimate, f.std_error]
+                f.estimate, f.std_error = mode.frequency_hz, mode.std_error_hz
+                break
+
+
+def driven_modes(findings: list) -> list[DrivenMode]:
+    """The driven-mode models the findings carry (:func:`attach_mode_models`)."""
+    return [DrivenMode.from_dict(f.details["mode_model"]) for f in findings
+            if f.effect == "structural_mode" and f.details.get("mode_model")]
+
+
+def with_mode_band(p: Prepared, smooth: dict[str, np.ndarray], modes: list[DrivenMode]) -> dict[str, np.ndarray]:
+    """The smoothed record with each modelled mode's band (:meth:`DrivenMode.band_hz`) of what
+    the common filter removed put back, in the outputs the mode rings: the mode is motion, not
+    noise, and the fit before and after is judged against it (the white noise inside the
+    band stays; outside it the record is the smoothed one)."""
+    out = dict(smooth)
+    for m in modes:
+        for c in m.gains:
+            if c in p.raw and c in out:
+                out[c] = out[c] + band_part(p.raw[c] - smooth[c], p.dt, m.band_hz())
+    return out
