@@ -189,7 +189,7 @@ def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect
     for c in OUTPUTS:
         if c in p.raw:
             series[f"meas_{c}"] = p.raw[c]
-            series[f"smooth_{c}"] = p.smooth[c]
+            series[f"smooth_{c}"] = smooth[c]  # with a modelled mode's band put back
             series[f"before_{c}"] = sim_b[c]
             series[f"after_{c}"] = sim_a[c]
     for c in COEFFICIENTS:

@@ -8,9 +8,9 @@ acceleration, so each output rings as a combination of the two responses
     r_acc = s² H(s) u / ω²,   r_rate = s H(s) u / ω,   H(s) = ω² / (s² + 2ζωs + ω²),
 
 both of which vanish at low frequency (the rigid-body band the aerodynamics own). Their gains
-are fitted, per output, to what the recording's common filter leaves of it (its content
-above the rigid-body band), with f and ζ found by variable projection (the gains solved
-linearly for each trial f, ζ)."""
+are fitted, per output, to the record's content in a band about the spectral peak that named
+the mode, u the surface's Wiener estimate, with f and ζ found by variable projection (the
+gains solved linearly for each trial f, ζ)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
