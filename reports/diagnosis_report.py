@@ -246,8 +246,12 @@ def model_section(data: Mapping, out_dir: Path) -> Section:
         found = "" if (out_dir / xml).is_file() else " (not found in the folder)"
         lines.append(f"Augmented model: {xml}, relative to {out_dir}{found}.")
     table = _terms_table(model.get("terms"))
+    outside = [m for m in model.get("outside_the_aircraft") or [] if isinstance(m, Mapping)]
     if table is None:
-        lines.append("No term was added: the augmented model is the model as given.")
+        lines.append("No term was added to the aircraft: the augmented aircraft is the model as given."
+                     if outside else "No term was added: the augmented model is the model as given.")
+    for m in outside:  # a structural mode, turbulence: sensor- and atmosphere-side models (model/sensors.json)
+        lines.append(f"Modelled outside the aircraft, {m.get('effect', '?')}: {m.get('model', '')}.")
     for maneuver in MANEUVERS:
         if inputs.get(maneuver):
             lines.append(f"{maneuver.capitalize()} recording: {inputs[maneuver]}.")

@@ -204,3 +204,16 @@ def test_none_report_shows_the_detection_limits(tmp_path):
     rows = table.frame.to_dict("records")
     assert rows[0]["parameter"] == "Cm_qhat" and rows[0]["of the model's value"] == "10 %"
     assert rows[1]["of the model's value"] == "—" and rows[1]["set by"] == "practical size"
+
+
+def test_models_outside_the_aircraft_are_shown(tmp_path):
+    """A structural mode (or turbulence) changes no aircraft term: the chosen-model section
+    says the aircraft is unchanged and names the model outside it (model/sensors.json)."""
+    from reports.diagnosis_report import model_section
+    data = {"model": {"base": "f16", "augmented_xml": None, "terms": [],
+                      "outside_the_aircraft": [{"effect": "structural_mode",
+                                                "model": "second-order mode driven by de"}]}}
+    lines = model_section(data, tmp_path).paragraphs
+    assert any("No term was added to the aircraft" in s for s in lines)
+    assert any(s.startswith("Modelled outside the aircraft, structural_mode: second-order mode driven by de")
+               for s in lines)

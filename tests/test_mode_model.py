@@ -118,4 +118,5 @@ def test_gallery_structural_mode(tmp_path):
     sensors = {s["effect"]: s for s in
                __import__("json").loads((tmp_path / "out" / "model" / "sensors.json").read_text())}
     assert sensors["structural_mode"]["surface"] == "de"
+    assert [m["effect"] for m in r["model"]["outside_the_aircraft"]] == ["structural_mode"]
     assert "natural frequency" in f["explanation"]

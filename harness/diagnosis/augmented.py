@@ -422,13 +422,14 @@ def write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ..
     terms = [e.describe() | {"parameter": e.parameter} for e in added]
     sensors = [t for t, e in zip(terms, added) if e.effect.startswith("sensor_")] + list(other or [])
     write_text_atomic(dest / "sensors.json", json.dumps(sensors, indent=1))
+    outside = {"outside_the_aircraft": list(other)} if other else {}
     if not any(not e.effect.startswith("sensor_") for e in added):
-        return {"base": aircraft.model, "augmented_xml": None, "terms": terms,
+        return {"base": aircraft.model, "augmented_xml": None, "terms": terms, **outside,
                 "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
     root, name = hidden_root(replace(aircraft, hidden=added), ic.condition(), refs)
     src = root / "aircraft" / name / f"{name}.xml"
     target = dest / f"{aircraft.name}-diagnosed.xml"
     write_atomic(target, lambda fh: fh.write(src.read_bytes()))
-    return {"base": aircraft.model, "augmented_xml": str(target.relative_to(out)), "terms": terms,
+    return {"base": aircraft.model, "augmented_xml": str(target.relative_to(out)), "terms": terms, **outside,
             "note": ("a control delay is a property (sidbench/<surface>-delay-delta-rad) the sidbench flight loop "
                      "drives; the aerodynamic terms fly in any JSBSim")}
