@@ -301,12 +301,26 @@ def test_gallery_turbulence_becomes_a_process_noise_model(gallery):
     """Filter error's gust state on the recording itself: its σ_w is the gust the kinematics
     saw (the gallery's moderate Dryden: σ about 4.6-7.7 ft/s), and its Kalman filter follows
     the flight far better than output error without the gust."""
-    pm = gallery["turbulence"]["findings"][0]["evidence"]["process_noise_model"]
+    pm = gallery["turbulence"]["findings"][0]["evidence"]["process_noise_model"]["short_period"]
     assert pm["fitted"]
     assert 3.0 < pm["sigma_w_fps"] < 12.0
     assert abs(pm["sigma_w_fps"] - 6.0) < 3.0 * pm["sigma_w_std_error_fps"] + 1.0
     assert pm["rms_filter_error"]["alpha"] < 0.5 * pm["rms_output_error"]["alpha"]
     for o in ("q", "az"):
+        assert pm["rms_filter_error"][o] < pm["rms_output_error"][o]
+
+
+def test_gallery_turbulence_lateral_process_noise_model(gallery):
+    """The gallery's maneuver drives the aileron and rudder too: the lateral-directional model
+    with a first-order gust on β is fitted as well; its σ_v = V σ_β agrees with the lateral
+    gust the kinematics saw (within three standard errors of the two), and its Kalman filter
+    follows β and r better than output error without the gust."""
+    f = gallery["turbulence"]["findings"][0]
+    pm = f["evidence"]["process_noise_model"]["lateral"]
+    assert pm["fitted"]
+    kinematic = f["evidence"]["sigma_v_fps"]
+    assert abs(pm["sigma_v_fps"] - kinematic) < 3.0 * math.hypot(pm["sigma_v_std_error_fps"], f["std_error"])
+    for o in ("beta", "r"):
         assert pm["rms_filter_error"][o] < pm["rms_output_error"][o]
 
 

@@ -7,9 +7,8 @@ drives the aircraft, and a replay without it drifts away. The filter-error metho
 first-order (Dryden) state disturbing α, σ and τ estimated with the derivatives, and its
 Kalman filter follows the flight through the gusts. Fitted to the same recording with and
 without it (output error), the two say how much of the mismatch the process-noise model
-accounts for, and σ_w = V σ_α estimates the vertical gust a second way. The short-period
-model is the one the filter-error defaults were validated on (README, the ``turbulence``
-campaign), so the fit is made only when the stabilator drove the maneuver.
+accounts for, and σ_w = V σ_α (σ_v = V σ_β on the lateral-directional model) estimates the
+gust a second way. Each model is fitted only when its surfaces drove the maneuver.
 """
 from __future__ import annotations
 
@@ -24,19 +23,40 @@ def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(x - np.mean(x)))))
 
 
-def process_noise_model(p: Prepared) -> dict:
-    """Filter error against output error on the short period of ``p`` (module docstring).
+# The filter-error models tried, by the surfaces that must have driven the maneuver: the
+# gust state on α (the vertical gust, σ_w = V σ_α) for the short period, on β (the lateral
+# gust, σ_v = V σ_β) for the lateral-directional model.
+AXES = (("short_period", "short-period", "alpha", ("de",), "sigma_w_fps"),
+        ("lateral", "lateral", "beta", ("da", "dr"), "sigma_v_fps"))
 
-    Returns ``{"fitted": False, "reason": ...}`` when it cannot be made, else the gust's
-    σ_w (ft/s, with its standard error by the delta method), τ (s), its length scale
-    L_w = V τ (ft), and per output the RMS of output error's residuals ("before": no gust)
-    and of the Kalman filter's innovations ("after": with the gust state)."""
-    if "de" not in p.driven or p.recording is None:
-        return {"fitted": False, "reason": "the stabilator did not drive the maneuver (the gust state is fitted "
-                                           "on the short period only)"}
+
+def process_noise_model(p: Prepared) -> dict:
+    """Filter error against output error on the short period and the lateral-directional
+    motion of ``p``, each where its surfaces drove the maneuver (:data:`AXES`; module
+    docstring).
+
+    Returns ``{"fitted": bool, "short_period": {...}, "lateral": {...}}`` (an axis is left out
+    when its surfaces did not drive the maneuver; ``reason`` says why none was fitted). Each
+    fitted axis gives the gust's σ (``sigma_w_fps`` or ``sigma_v_fps``, ft/s, with its standard
+    error by the delta method), τ (s), its length scale V τ (ft), and per output the RMS of
+    output error's residuals ("before": no gust) and of the Kalman filter's innovations
+    ("after": with the gust state)."""
+    out: dict = {}
+    if p.recording is not None:
+        for key, model, gust, surfaces, sigma_name in AXES:
+            if any(s in p.driven for s in surfaces):
+                out[key] = _axis_model(p, model, gust, sigma_name)
+    fitted = any(m.get("fitted") for m in out.values())
+    if not out:
+        out["reason"] = "no surface drove the maneuver (or the recording is not at hand): no gust model is fitted"
+    return {"fitted": fitted, **out}
+
+
+def _axis_model(p: Prepared, model: str, gust: str, sigma_name: str) -> dict:
+    """One axis's filter-error fit with a first-order gust on ``gust`` against output error."""
     try:
-        fe = FilterError(model="short-period").fit(p.recording)
-        oe = OutputError(model="short-period").fit(p.recording)
+        fe = FilterError(model=model, gust=gust).fit(p.recording)
+        oe = OutputError(model=model).fit(p.recording)
     except (ValueError, np.linalg.LinAlgError, RuntimeError) as exc:
         return {"fitted": False, "reason": f"the filter-error fit failed: {exc}"}
     V = float(np.mean(p.smooth["V"]))
@@ -46,8 +66,8 @@ def process_noise_model(p: Prepared) -> dict:
     outputs = fe.dependent.split(",")  # the model's outputs, in the residuals' column order
     before = {o: _rms(oe.residuals[:, i]) for i, o in enumerate(outputs)}
     after = {o: _rms(fe.residuals[:, i]) for i, o in enumerate(outputs)}
-    return {"fitted": True, "method": "filter error (fe), short-period model with a first-order gust on alpha",
-            "sigma_w_fps": float(sigma), "sigma_w_std_error_fps": float(sigma * se_ln) if np.isfinite(se_ln) else None,
-            "tau_s": float(np.exp(ln_tau)), "L_w_ft": float(V * np.exp(ln_tau)),
+    return {"fitted": True, "method": f"filter error (fe), {model} model with a first-order gust on {gust}",
+            sigma_name: float(sigma), f"{sigma_name[:-4]}_std_error_fps": float(sigma * se_ln) if np.isfinite(se_ln)
+            else None, "tau_s": float(np.exp(ln_tau)), "length_scale_ft": float(V * np.exp(ln_tau)),
             "rms_output_error": before, "rms_filter_error": after,
             "change": {o: after[o] / before[o] - 1.0 for o in outputs if before[o] > 0}}

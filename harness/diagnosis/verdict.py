@@ -195,6 +195,27 @@ EXPLAIN_VANE_OFFSET = ("The {channel} vane is not at the c.g.: it reads the flow
 _VANE_ROTATION = {"alpha": "−x·q/V", "beta": "x·r/V"}
 
 
+def _process_noise_text(c: Candidate) -> str:
+    """What the turbulence's process-noise models (``details['process_noise_model']``,
+    harness.diagnosis.gusts) say: each fitted axis's gust σ and how much closer its Kalman
+    filter follows the outputs than output error without the gust."""
+    pm = c.details.get("process_noise_model") if c.effect == "turbulence" else None
+    if not pm:
+        return ""
+    parts = []
+    for key, words, sigma in (("short_period", "short period", "sigma_w"), ("lateral", "lateral motion", "sigma_v")):
+        m = pm.get(key) or {}
+        if not m.get("fitted"):
+            continue
+        se = m.get(f"{sigma}_std_error_fps")
+        change = ", ".join(f"{o} {100 * v:+.0f} %" for o, v in m["change"].items())
+        parts.append(f"on the {words}, σ = {m[f'{sigma}_fps']:.1f}" + (f" ± {se:.1f}" if se else "")
+                     + f" ft/s (its Kalman filter against output error without the gust: {change})")
+    if not parts:
+        return ""
+    return " The filter-error method fits a process-noise model (a first-order gust state) " + "; ".join(parts) + "."
+
+
 def _mode_model_text(c: Candidate) -> str:
     """How a structural mode is modelled (``details['mode_model']``, harness.diagnosis.mode_model)."""
     if c.effect != "structural_mode" or "mode_model" not in c.details:
@@ -244,7 +265,7 @@ def finding_dict(c: Candidate, fits_b: dict, fits_a: dict, check: dict | None = 
     elif both:  # named on the two maneuvers
         text += (f" The identification maneuver rings it too weakly to name alone (p = {both['identification_p']:.2g} "
                  f"at that frequency); the validation maneuver's peak (p = {both['validation_p']:.2g}) names it.")
-    text += _mode_model_text(c)
+    text += _mode_model_text(c) + _process_noise_text(c)
     if c.details.get("not_ruled_out"):  # an assumption it rests on (term_rules: a skewed delay, an untested coupling)
         text += f" Caveat: {c.details['not_ruled_out']}."
     evidence = {"test": c.test, "t": c.t, "explained_fraction": c.explained_fraction, "reason": c.reason}
