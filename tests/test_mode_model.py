@@ -120,3 +120,5 @@ def test_gallery_structural_mode(tmp_path):
     assert sensors["structural_mode"]["surface"] == "de"
     assert [m["effect"] for m in r["model"]["outside_the_aircraft"]] == ["structural_mode"]
     assert "natural frequency" in f["explanation"]
+    assert 0.0 < f["evidence"]["explained_fraction"] <= 1.0  # a share, not the peak's height over its median
+    assert f["evidence"]["peak_over_median"] > 1.0

@@ -120,10 +120,13 @@ def withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:
 
 def mode_candidate(peak, selected: bool, reason: str) -> Candidate:
     """The structural-mode candidate of spectral peak ``peak`` (:class:`spectra.PeakTest`):
-    its frequency, with −log10 p as its t."""
+    its frequency, with −log10 p as its t and, as the share it explains, the peak's excess
+    power over the variance of what the common filter leaves of the channel (the ordinate
+    over its local median is kept as ``details['peak_over_median']``)."""
     return Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
-                     peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), peak.g, "Hz",
-                     "residual-spectrum peak over its local median", selected, reason, {"amplitude": peak.amplitude})
+                     peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), min(peak.share, 1.0), "Hz",
+                     "residual-spectrum peak over its local median", selected, reason,
+                     {"amplitude": peak.amplitude, "peak_over_median": peak.g})
 
 
 def spectral_candidates(peak, gust, turbulent: bool, light: bool = False,

@@ -37,6 +37,7 @@ class PeakTest:
     amplitude: float
     g: float          # the peak's periodogram ordinate over its local median
     p_value: float
+    share: float = float("nan")  # the peak's excess power over the variance of what the filter leaves
 
 
 def peak_p_value(ratio: float, m: int, dof: float) -> float:
@@ -98,7 +99,9 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
             nb = slice(max(k - 1, 0), min(k + 2, f.size))
             excess = np.maximum(P[nb] - med[nb], 0.0)
             fc, se = _refine(x, fs, float(f[k]), df, nper)
-            best = PeakTest(c, fc, se, float(np.sqrt(np.sum(excess) * df)), float(ratio.max()), pv)
+            power = float(np.sum(excess) * df)
+            best = PeakTest(c, fc, se, float(np.sqrt(power)), float(ratio.max()), pv,
+                            power / max(float(np.var(x)), 1e-300))
     return best
 
 
