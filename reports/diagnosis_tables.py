@@ -162,7 +162,9 @@ def candidates_table(candidates: Sequence[Mapping]) -> Table:
                   for col in ("effect", "t", "selected"))
     return Table("Candidates", frame,
                  "Every candidate effect tested, by descending |t|. Green: selected into the model. "
-                 "explained_fraction is the share of the mismatch the candidate explains alone.",
+                 "explained_fraction is the share of the mismatch the candidate explains alone (a structural "
+                 "mode's: of what the common filter leaves of its channel; none for turbulence, which drives "
+                 "the flight rather than adding a term).",
                  tuple((int(i), c, css) for i, c, css in marks))
 
 def _fit_value(fit: Mapping, group: str, name: str, metric: str) -> float:

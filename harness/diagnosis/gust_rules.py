@@ -149,8 +149,9 @@ def spectral_candidates(peak, gust, turbulent: bool, light: bool = False,
         sigma = gust.sigma_w_fps * float(np.sqrt(min(max(air.share, 0.0), 1.0)))
         details["light"] = True
         reason += " (light turbulence: the aerodynamics followed the vanes' angle, the air's)"
-    out.append(Candidate("turbulence", None, None, "sigma_gust_fps", sigma, sigma / 4.0, gust.ratio_to_noise, 0.0,
-                         "ft/s", "air-relative vs inertial velocity (integrated kinematic residual)",
+    # no share of the mismatch: the gust drives the flight, it is not a term fitted to the mismatch
+    out.append(Candidate("turbulence", None, None, "sigma_gust_fps", sigma, sigma / 4.0, gust.ratio_to_noise,
+                         float("nan"), "ft/s", "air-relative vs inertial velocity (integrated kinematic residual)",
                          turbulent or light, reason, details))
     return out
 
