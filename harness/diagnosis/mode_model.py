@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage, optimize, signal, stats
 
+from estimators.filter_error import MAD_TO_SIGMA
 from harness.diagnosis.prepare import Prepared, interior_slice
 from harness.diagnosis.spectra import MODE_CHANNELS, MODE_DRIVERS
 
@@ -88,13 +89,13 @@ def mode_responses(u: np.ndarray, dt: float, frequency_hz: float, damping: float
 
 def white_noise_std(x: np.ndarray) -> float:
     """The standard deviation of a record's white noise from its fourth differences: robustly
-    (median absolute deviation / 0.6745), and with their variance 70 σ² for white noise
+    (median absolute deviation over that of a unit normal, ``MAD_TO_SIGMA``), and with their variance 70 σ² for white noise
     (the sum of the squared binomial coefficients, C(8, 4)). A fourth difference passes a
     2 Hz motion at 50 samples/s at 0.4 % of its amplitude and puts a step's edge into four
     samples only, so neither the maneuver's motion nor the sharp edges of a step input (whose
     spectrum can stand above the noise up to Nyquist) are counted as noise."""
     d = np.diff(np.asarray(x, dtype=float), 4)
-    return float(np.median(np.abs(d - np.median(d))) / 0.6745 / np.sqrt(70.0))
+    return float(np.median(np.abs(d - np.median(d))) / MAD_TO_SIGMA / np.sqrt(70.0))
 
 
 def wiener_surface(u: np.ndarray, dt: float, segment_s: float = 2.0) -> np.ndarray:
@@ -105,9 +106,9 @@ def wiener_surface(u: np.ndarray, dt: float, segment_s: float = 2.0) -> np.ndarr
     the noise) and interpolated to the record's frequencies, N the one-sided density of the
     sensor's white noise (:func:`white_noise_std`). A mode's resonance rings the sensor noise
     of a surface as loudly as its motion near the mode (0.05 deg of potentiometer noise on a
-    2 deg doublet, an 8 Hz mode at ζ 0.02): a response built on the raw record would fit that ringing's share
-    as missing gain; built on this estimate its gains are unbiased (its error is uncorrelated
-    with it)."""
+    2 deg doublet, an 8 Hz mode at ζ 0.02): a response built on the raw record would fit that
+    ringing's share as missing gain; built on this estimate its gains are unbiased (its error
+    is uncorrelated with it)."""
     x = np.asarray(u, dtype=float)
     nper = min(int(round(segment_s / dt)), x.size)
     f, P = signal.welch(x, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper // 2, detrend="linear")
