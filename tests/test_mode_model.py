@@ -122,3 +122,44 @@ def test_gallery_structural_mode(tmp_path):
     assert "natural frequency" in f["explanation"]
     assert 0.0 < f["evidence"]["explained_fraction"] <= 1.0  # a share, not the peak's height over its median
     assert f["evidence"]["peak_over_median"] > 1.0
+
+
+def _without_mode(p, seed: int = 5):
+    """``p`` with q and a_z replaced by their smoothed records plus white noise of their level:
+    no mode left to fit."""
+    from dataclasses import replace
+    rng = np.random.default_rng(seed)
+    raw = dict(p.raw)
+    for c in ("q", "az"):
+        raw[c] = p.smooth[c] + rng.normal(scale=p.noise_std[c], size=p.n)
+    return replace(p, raw=raw)
+
+
+def test_a_mode_the_identification_does_not_ring_is_fitted_on_the_validation(driven):
+    """attach_mode_models: the identification maneuver holds no mode to fit, the validation
+    maneuver does: the model is the validation's, ``fitted_on`` says so, and the finding's
+    estimate becomes the fitted natural frequency (the spectral peak kept apart)."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.mode_model import attach_mode_models
+    truth, p = driven
+    f = Candidate("structural_mode", None, "q", "mode_frequency_hz", 7.7, 0.25, 10.0, 0.2, "Hz", "peak", True)
+    attach_mode_models([f], {"identification": _without_mode(p), "validation": p})
+    assert f.details["mode_model"]["fitted_on"] == "validation"
+    assert f.details["spectral_peak_hz"] == [7.7, 0.25]
+    assert f.estimate == f.details["mode_model"]["frequency_hz"] and abs(f.estimate - truth.frequency_hz) < 0.2
+    g = Candidate("structural_mode", None, "q", "mode_frequency_hz", 7.7, 0.25, 10.0, 0.2, "Hz", "peak", True)
+    attach_mode_models([g], {"identification": _without_mode(p)})
+    assert g.details["mode_model"] is None and g.estimate == 7.7  # the notch stands for it
+
+
+def test_the_mode_band_is_put_back_only_where_the_mode_rings(driven):
+    """with_mode_band adds the band of what the common filter removed to the outputs the mode
+    has gains in, and leaves the others as smoothed."""
+    from harness.diagnosis.mode_model import with_mode_band
+    _, p = driven
+    m = DrivenMode(8.0, 0.01, 0.02, "de", {"q": (-0.5, 0.0)})
+    out = with_mode_band(p, p.smooth, [m])
+    assert np.array_equal(out["az"], p.smooth["az"]) and np.array_equal(out["alpha"], p.smooth["alpha"])
+    added = out["q"] - p.smooth["q"]
+    assert np.allclose(added, band_part(p.raw["q"] - p.smooth["q"], p.dt, m.band_hz()))
+    assert np.std(added) > 0.5 * np.std(band_part(p.raw["q"], p.dt, m.band_hz()))
