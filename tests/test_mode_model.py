@@ -122,6 +122,8 @@ def test_gallery_structural_mode(tmp_path):
     assert "natural frequency" in f["explanation"]
     assert 0.0 < f["evidence"]["explained_fraction"] <= 1.0  # a share, not the peak's height over its median
     assert f["evidence"]["peak_over_median"] > 1.0
+    summary = r["located"]["summary"]  # what is left is told in the measure the paragraph opens with too
+    assert "is still" not in summary or "of it follows the maneuver)" in summary
 
 
 def _without_mode(p, seed: int = 5):

@@ -9,6 +9,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis.analysis import analyse
 from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_all, refine_in_the_loop, replay_before,
@@ -20,10 +22,10 @@ from harness.diagnosis.mode_model import attach_mode_models
 from harness.diagnosis.prepare import instruments_at_cg, prepare
 from harness.diagnosis.reference_point import choose_reference_point
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
-from harness.diagnosis.validation import undecided, validation_check
+from harness.diagnosis.validation import after_mismatch, undecided, validation_check
 from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, check_time_base,
                                        chosen_findings, excited_axes, finding_dict, focus_axis, located_paragraph,
-                                       none_finding, not_checked, remaining_mismatch)
+                                       none_finding, not_checked, remaining_mismatch, structured_part)
 from harness.executors import LocalPool
 from harness.recording_io import read_recording
 from models.aircraft import (AERO_REFERENCES, MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument,
@@ -197,8 +199,10 @@ def _after_findings(located: dict, a: Analysis, findings: list[Candidate]) -> No
     w = located["remaining"][worst]
     removed = f"{100 * w['removed']:.0f} % of it removed" if w["removed"] >= 0.005 else "none of it removed"
     if w["ratio"] >= UNEXPLAINED_RATIO:
+        # the part of it that follows the maneuver, in the measure the paragraph opened with
+        left = float(np.std(structured_part(a.prepared, after_mismatch(a, findings)[0][worst]))) / a.noise[worst]
         located["summary"] += (f" After the findings, the mismatch left in {worst} is still {w['ratio']:.1f} times "
-                               f"its noise level ({removed})"
+                               f"its noise level ({removed}; {left:.1f} of it follows the maneuver)"
                                + (": no candidate term explains it." if w["removed"] < 0.2 else "."))
     else:
         located["summary"] += (f" After the findings, no axis's mismatch is above {UNEXPLAINED_RATIO:g} times its "
