@@ -165,3 +165,15 @@ def test_the_mode_band_is_put_back_only_where_the_mode_rings(driven):
     added = out["q"] - p.smooth["q"]
     assert np.allclose(added, band_part(p.raw["q"] - p.smooth["q"], p.dt, m.band_hz()))
     assert np.std(added) > 0.5 * np.std(band_part(p.raw["q"], p.dt, m.band_hz()))
+
+
+def test_a_record_whose_smoothing_keeps_the_whole_band_has_none_to_search(driven):
+    """spectra.untestable_at: three times a common-filter cut-off of 9 Hz (27 Hz) lies above
+    0.9 of a 50 Hz record's Nyquist (22.5 Hz): no band, said so (not an inverted band)."""
+    from dataclasses import replace
+
+    from harness.diagnosis.spectra import untestable_at
+    _, p = driven
+    why = untestable_at(replace(p, common_cutoff_hz=9.0), "q", 8.0)
+    assert why.startswith("it has no spectral band to search") and "22.5 Hz" in why
+    assert untestable_at(p, "q", 8.0) == ""

@@ -178,6 +178,10 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
     if p.n < 4 * int(round(segment_s * fs)):
         return f"it is shorter than {4 * segment_s:g} s"
     low = max(f_min_hz, 3.0 * p.common_cutoff_hz)
+    if low >= 0.45 * fs:
+        return (f"it has no spectral band to search: three times its common filter's cut-off of "
+                f"{p.common_cutoff_hz:.1f} Hz lies above 0.9 of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping "
+                "everything below as motion")
     if not low <= frequency_hz <= 0.9 * 0.5 * fs:
         return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or three times its common "
                 f"filter's cut-off of {p.common_cutoff_hz:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
