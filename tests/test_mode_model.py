@@ -177,3 +177,12 @@ def test_a_record_whose_smoothing_keeps_the_whole_band_has_none_to_search(driven
     why = untestable_at(replace(p, common_cutoff_hz=9.0), "q", 8.0)
     assert why.startswith("it has no spectral band to search") and "22.5 Hz" in why
     assert untestable_at(p, "q", 8.0) == ""
+
+
+def test_a_record_too_short_for_the_spectral_test_is_not_fitted(driven):
+    from dataclasses import replace
+    _, p = driven
+    k = int(6.0 / p.dt)
+    short = replace(p, t=p.t[:k], raw={c: v[:k] for c, v in p.raw.items()},
+                    smooth={c: v[:k] for c, v in p.smooth.items()})
+    assert fit_driven_mode(short, "q", 8.0) is None

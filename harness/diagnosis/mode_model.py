@@ -39,6 +39,9 @@ WIENER_BINS = 5
 # power in the channel the peak is in.
 MAX_DAMPING = 0.2
 MIN_EXPLAINED = 0.3
+# The shortest record a mode is fitted on: the spectral test's four 2 s Welch segments
+# (spectra.structural_peak).
+MIN_RECORD_S = 8.0
 # Half-width of the band a mode's fit is judged in: at least this, or two half-power
 # bandwidths (2ζf each) of the fitted mode.
 BAND_MIN_HALF_WIDTH_HZ = 0.5
@@ -160,6 +163,8 @@ def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float) -> DrivenMod
     inner = interior_slice(p.n, p.dt)
     surfaces = [s for s in MODE_DRIVERS.get(channel, ()) if s in p.raw and np.ptp(p.raw[s]) > 0]
     if channel not in p.raw or not surfaces or not 0.0 < frequency_hz < 0.45 / p.dt:
+        return None
+    if p.t[-1] < MIN_RECORD_S:  # a record the spectral test could not have named a mode on
         return None
     band = _fit_band(frequency_hz)
     n_eff = 2 * int(np.count_nonzero((np.fft.rfftfreq(p.n, p.dt) >= band[0])
