@@ -167,8 +167,9 @@ def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float) -> DrivenMod
     if p.t[-1] < MIN_RECORD_S:  # a record the spectral test could not have named a mode on
         return None
     band = _fit_band(frequency_hz)
-    n_eff = 2 * int(np.count_nonzero((np.fft.rfftfreq(p.n, p.dt) >= band[0])
-                                     & (np.fft.rfftfreq(p.n, p.dt) <= band[1])))
+    freqs = np.fft.rfftfreq(p.n, p.dt)
+    # two degrees of freedom per Fourier ordinate in the band, for the interior samples fitted
+    n_eff = int(2 * np.count_nonzero((freqs >= band[0]) & (freqs <= band[1])) * (inner.stop - inner.start) / p.n)
     y = band_part(p.raw[channel], p.dt, band)[inner]
     drive = {s: wiener_surface(p.raw[s], p.dt) for s in surfaces}
 
@@ -185,7 +186,8 @@ def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float) -> DrivenMod
                                     (np.log(DAMPING_BOUNDS[0]), np.log(DAMPING_BOUNDS[1]))],
                             options={"xatol": 1e-4, "fatol": 1e-12 * float(y @ y), "maxiter": 200})
     f, z = float(res.x[0]), float(np.exp(res.x[1]))
-    R = _in_band(mode_responses(drive[s], p.dt, f, z), p.dt, band)[inner]
+    R_all = _in_band(mode_responses(drive[s], p.dt, f, z), p.dt, band)
+    R = R_all[inner]
     se_f = _frequency_se(lambda ff: sse(s, ff, z), f, n_eff)
     gains, explained = {}, {}
     judged = DrivenMode(f, se_f, z, s).band_hz()
@@ -197,7 +199,7 @@ def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float) -> DrivenMod
         if pv < GAIN_P:
             gains[c] = (float(g[0]), float(g[1]))
             yb = band_part(p.raw[c], p.dt, judged)[inner]
-            fit = band_part(R @ g, p.dt, judged)
+            fit = band_part(R_all @ g, p.dt, judged)[inner]
             explained[c] = float(1.0 - np.sum((yb - fit) ** 2) / max(float(yb @ yb), 1e-300))
     if channel not in gains:
         return None

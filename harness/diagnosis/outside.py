@@ -26,7 +26,8 @@ of the model itself: no noise, no actuator, no rounding) of the F-16, the 737 an
 Scoring (per case, and totals): (a) the right effect *and parameter* first; (b) its size
 within 2 standard errors or 25 %; (c) false findings: every finding other than the true one
 (on a null, every finding but ``none``); (d) the validation RMS of the affected output drops
-by 30 % or more (turbulence excepted; a structural mode's on the raw record, where it rings).
+by 30 % or more (turbulence excepted; a structural mode's against the smoothed record with
+the mode's band put back, as the diagnosis reports it).
 """
 from __future__ import annotations
 
