@@ -59,14 +59,16 @@ class ColoredSelection:
 
 
 def colored_fit(z: np.ndarray, columns: Sequence[np.ndarray], names: Sequence[str], max_lag: int | None = None,
-                constant: bool = True):
+                constant: bool = True, autocorrelation: str = "sample"):
     """Least squares (with a constant term unless ``constant=False``) and colored-residual
-    covariance. Returns ``(theta, std_errors, residuals)``, the constant last."""
+    covariance (Eq. 40; ``autocorrelation`` as in
+    :func:`estimators.colored.colored_residual_covariance`). Returns ``(theta, std_errors,
+    residuals)``, the constant last."""
     if not constant and not len(columns):
         return np.zeros(0), np.zeros(0), np.asarray(z, dtype=float).copy()
     A = np.column_stack(list(columns) + ([np.ones(z.size)] if constant else []))
     ls = least_squares(A, z, tuple(names) + (("bias",) if constant else ()))
-    cov = colored_residual_covariance(A, ls.residuals, max_lag=max_lag)
+    cov = colored_residual_covariance(A, ls.residuals, max_lag=max_lag, autocorrelation=autocorrelation)
     return ls.theta, np.sqrt(np.maximum(np.diag(cov), 0.0)), ls.residuals
 
 

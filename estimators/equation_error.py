@@ -24,6 +24,7 @@ from maneuvers.recording import Recording
 from models.errors import OptionError
 
 ERRORS = ("conventional", "colored")
+AUTOCORRELATIONS = ("sample", "ar")  # Eq. 39 estimates, or their autoregressive model (estimators.colored)
 DETRENDS = ("lstsq", "endpoints")
 # Named frequency bands of the frequency-domain method: "auto", the seed's rule (2/T to 1.2 Hz
 # by 0.04 Hz, §II after Eq. 18); "eq18" (alias "sidpac"), Eq. 18's fixed 0.20:0.04:1.20 Hz,
@@ -107,7 +108,9 @@ class EquationErrorTime:
     Parameters
     ----------
     errors : ``'conventional'`` (Eq. 15, white residuals) or ``'colored'`` (Eqs. 37-41, the
-        residual autocorrelation up to ``max_lag`` samples; all lags when None). ``None``
+        residual autocorrelation up to ``max_lag`` samples; all lags when None; with
+        ``autocorrelation='ar'`` that of an autoregressive model of the residuals, see
+        :func:`estimators.colored.colored_residual_covariance`). ``None``
         (default) is the method's own: ``'colored'`` with smoothed regressors (smoothing
         colours the residuals, and the seed's §III.E finds the colored bounds of smoothed
         regressors accurate), ``'conventional'`` without. Either way the fit warns when the
@@ -130,6 +133,7 @@ class EquationErrorTime:
 
     errors: str | None = None
     max_lag: int | None = None
+    autocorrelation: str = "sample"
     smooth_regressors: bool = False
     data: DataOptions = field(default_factory=DataOptions)
 
@@ -138,6 +142,10 @@ class EquationErrorTime:
             object.__setattr__(self, "errors", "colored" if self.smooth_regressors else "conventional")
         if self.errors not in ERRORS:
             raise OptionError(f"errors must be one of {ERRORS}, not {self.errors!r}")
+        if self.autocorrelation not in AUTOCORRELATIONS:
+            raise OptionError(f"autocorrelation must be one of {AUTOCORRELATIONS}, not {self.autocorrelation!r}")
+        if self.autocorrelation != "sample" and self.errors != "colored":
+            raise OptionError("autocorrelation applies to the colored errors (Eq. 40), not to the conventional ones")
 
     @property
     def method(self) -> str:
@@ -154,7 +162,8 @@ class EquationErrorTime:
             info["smoother_cutoff_hz"] = max(f.cutoff_hz for f in fits)
         A = np.column_stack([X, np.ones(len(z))]) if d.equation.bias else X
         ls = least_squares(A, z, d.names, keep_factor=True)
-        cov_colored = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag, factor=ls.factor)
+        cov_colored = colored_residual_covariance(A, ls.residuals, max_lag=self.max_lag, factor=ls.factor,
+                                                  autocorrelation=self.autocorrelation)
         ls = replace(ls, factor=None)  # Q is N x n_p: not kept past its use
         cov_conventional = ls.s2 * ls.xtx_inv
         cov = cov_colored if self.errors == "colored" else cov_conventional
@@ -167,7 +176,8 @@ class EquationErrorTime:
                         s2=ls.s2, r2=r_squared(z, ls.residuals), errors=self.errors, collinearity=coll,
                         warnings=_warnings(d.names, coll, d.notes) + ((colour,) if colour else ()),
                         assumptions=d.assumptions,
-                        info=info | ({"max_lag": self.max_lag if self.max_lag is not None else len(z) - 1}
+                        info=info | ({"max_lag": self.max_lag if self.max_lag is not None else len(z) - 1,
+                                      "autocorrelation": self.autocorrelation}
                                      if self.errors == "colored" else {}))
 
 

@@ -28,18 +28,20 @@ class Estimator(Protocol):
 
 
 def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None = None,
-                   frequencies_hz: tuple[float, ...] | str | None = None, detrend: str = "lstsq",
+                   autocorrelation: str = "sample", frequencies_hz: tuple[float, ...] | str | None = None,
+                   detrend: str = "lstsq",
                    data: DataOptions = DataOptions(), model: str | None = None,
                    acceleration: str = "time", hold: tuple[str, ...] = ()) -> Estimator:
     """The estimator called ``name`` (one of :data:`REGISTRY`).
 
     ``errors`` applies to the time-domain equation-error methods; ``None`` is the method's
     default: colored residuals (Eq. 40) for ``ee-smooth``, conventional (Eq. 15) for
-    ``ee-time``. The frequency-domain method's bounds are conventional (Eqs. 20-22, accurate
-    when the band holds the rigid-body dynamics, seed §III.E), and output error reports the
-    Cramér-Rao bound. ``frequencies_hz`` and ``detrend`` shape ``ee-freq``: by default the
-    seed's rule (2/T to 1.2 Hz by 0.04 Hz) and a least-squares line;
-    ``**SIDPAC_FREQUENCY_OPTIONS`` (``frequencies_hz='sidpac'``, ``detrend='endpoints'``)
+    ``ee-time``; ``autocorrelation`` the colored bounds' residual autocorrelation (``"sample"``,
+    Eq. 39; ``"ar"``, its autoregressive model, which makes a bias term's bound honest). The
+    frequency-domain method's bounds are conventional (Eqs. 20-22, accurate when the band
+    holds the rigid-body dynamics, seed §III.E), and output error reports the Cramér-Rao bound.
+    ``frequencies_hz`` and ``detrend`` shape ``ee-freq``: by default the seed's rule (2/T to
+    1.2 Hz by 0.04 Hz) and a least-squares line; ``**SIDPAC_FREQUENCY_OPTIONS`` (``frequencies_hz='sidpac'``, ``detrend='endpoints'``)
     gives SIDPAC's Eq. 18 band and end-point line. ``model`` names the output-error family's
     built-in model (None: chosen from the equation fitted). ``acceleration`` and ``hold`` are
     ``ee-freq``'s options for moment equations whose angular accelerations are differentiated
@@ -51,10 +53,14 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
         raise OptionError(f"--errors colored applies to the time-domain equation-error methods, not {name}: "
                           "the frequency-domain residuals are treated as white over the band (seed §III.E) "
                           "and output error reports the Cramér-Rao bound")
+    if autocorrelation != "sample" and not info.supports("colored"):
+        raise OptionError(f"--autocorrelation {autocorrelation} applies to the colored errors (Eq. 40) of the "
+                          f"time-domain equation-error methods, not to {name}")
     if name == "ee-time":
-        return EquationErrorTime(errors=errors, max_lag=max_lag, data=data)
+        return EquationErrorTime(errors=errors, max_lag=max_lag, autocorrelation=autocorrelation, data=data)
     if name == "ee-smooth":
-        return EquationErrorTime(errors=errors, max_lag=max_lag, smooth_regressors=True, data=data)
+        return EquationErrorTime(errors=errors, max_lag=max_lag, autocorrelation=autocorrelation,
+                                 smooth_regressors=True, data=data)
     if name == "ee-freq":
         return EquationErrorFrequency(frequencies_hz=frequencies_hz, detrend=detrend, data=data,
                                       acceleration=acceleration, hold=tuple(hold))
@@ -72,7 +78,7 @@ def make_estimator(name: str, *, errors: str | None = None, max_lag: int | None 
         return Stepwise(data=data)
     from estimators.multiple import Combined
     return Combined(method=name, errors=errors or "conventional", max_lag=max_lag,
-                    frequencies_hz=frequencies_hz, detrend=detrend)
+                    autocorrelation=autocorrelation, frequencies_hz=frequencies_hz, detrend=detrend)
 
 
 def parse_frequencies(text: str) -> tuple[float, ...] | str:

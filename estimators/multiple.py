@@ -47,6 +47,7 @@ class Combined:
     method: str = "ee-concat"
     errors: str = "conventional"
     max_lag: int | None = None
+    autocorrelation: str = "sample"
     frequencies_hz: npt.ArrayLike | str | None = None
     detrend: str = "lstsq"
 
@@ -55,7 +56,8 @@ class Combined:
         if equation is not None and any(d.equation != equation for d in datasets):
             raise ValueError("fit() got RegressionData and a different equation; pass one or the other")
         if self.method == "ee-concat":
-            return fit_concatenated(datasets, errors=self.errors, max_lag=self.max_lag)
+            return fit_concatenated(datasets, errors=self.errors, max_lag=self.max_lag,
+                                    autocorrelation=self.autocorrelation)
         if self.method in ("ee-sequential", "ee-sequential-unequal"):
             return fit_sequential(datasets, equal_variances=self.method == "ee-sequential")
         if self.method == "ee-freq-combined":
@@ -138,7 +140,7 @@ def concatenate(datasets: Sequence[RegressionData]) -> RegressionData:
 
 
 def fit_concatenated(datasets: Sequence[RegressionData], errors: str = "conventional", *,
-                     max_lag: int | None = None) -> ModelFit:
+                     max_lag: int | None = None, autocorrelation: str = "sample") -> ModelFit:
     """Least squares on the concatenated maneuvers (seed Eqs. 42, 14-16, 40).
 
     Parameters
@@ -150,6 +152,9 @@ def fit_concatenated(datasets: Sequence[RegressionData], errors: str = "conventi
         ``'colored'``: Eq. 40 with the residual autocorrelation taken *within* each maneuver.
     max_lag : int or None
         Largest lag r of Eq. 39 for ``'colored'`` (all lags of each maneuver when None).
+    autocorrelation : {'sample', 'ar'}
+        ``'colored'``: Eq. 39's estimates, or their autoregressive model's, of each maneuver
+        (:func:`estimators.colored.colored_residual_covariance`).
 
     Returns
     -------
@@ -177,10 +182,12 @@ def fit_concatenated(datasets: Sequence[RegressionData], errors: str = "conventi
     ls = least_squares(A, d.z, d.names)
     info: dict = {"maneuvers": len(ds), "lengths": [len(x.z) for x in ds]}
     if errors == "colored":
-        middle = sum(colored_middle(A[s], ls.residuals[s], max_lag) for s in _slices(ds))
+        middle = sum(colored_middle(A[s], ls.residuals[s], max_lag, autocorrelation=autocorrelation)
+                     for s in _slices(ds))
         cov = ls.xtx_inv @ middle @ ls.xtx_inv
         cov = 0.5 * (cov + cov.T)
         info["max_lag"] = max_lag if max_lag is not None else "all lags of each maneuver"
+        info["autocorrelation"] = autocorrelation
     else:
         cov = ls.s2 * ls.xtx_inv
     coll = collinearity(A, d.names, cov)

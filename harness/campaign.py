@@ -17,7 +17,7 @@ import tomllib
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from estimators.registry import COMBINED_METHODS, METHODS
+from estimators.registry import COMBINED_METHODS, METHODS, method_info
 from estimators.regressors import Equation
 from harness.errors import UserError
 from harness.noise import ChannelNoise, NoiseModel
@@ -448,7 +448,7 @@ def _methods(grid: dict, combine: bool, flights: tuple[FlightKey, ...], where: s
 
 
 def _method_options(d: dict, where: str) -> tuple[tuple[str, tuple], ...]:
-    """``[method_options.METHOD]``: frequencies, detrend, max_lag and hold of a method."""
+    """``[method_options.METHOD]``: frequencies, detrend, max_lag, autocorrelation and hold of a method."""
     method_options = []
     if not isinstance(d.get("method_options", {}), dict):
         raise CampaignError(f"{where}: method_options must be a table of [method_options.METHOD] tables")
@@ -457,10 +457,10 @@ def _method_options(d: dict, where: str) -> tuple[tuple[str, tuple], ...]:
             raise CampaignError(f"{where}: method_options.{m} must be a table")
         if m not in METHODS + COMBINED_METHODS:
             raise CampaignError(f"{where}: method_options.{m}: unknown method")
-        bad = set(opts) - {"frequencies", "detrend", "max_lag", "hold"}
+        bad = set(opts) - {"frequencies", "detrend", "max_lag", "autocorrelation", "hold"}
         if bad:
             raise CampaignError(f"{where}: method_options.{m}: unknown option(s) {sorted(bad)} "
-                                "(frequencies, detrend, max_lag, hold)")
+                                "(frequencies, detrend, max_lag, autocorrelation, hold)")
         _check_method_options(m, opts, where)
         method_options.append((m, tuple(sorted((k, tuple(v) if isinstance(v, list) else v)
                                                for k, v in opts.items()))))
@@ -530,6 +530,10 @@ def _check_method_options(method: str, opts: dict, file: str) -> None:
         raise CampaignError(f"{file}: {where}.detrend must be 'endpoints' or 'lstsq', not {opts['detrend']!r}")
     if "max_lag" in opts:
         _integer(opts["max_lag"], f"{where}.max_lag", file, minimum=0)
+    if "autocorrelation" in opts and (not method_info(method).supports("colored")
+                                      or opts["autocorrelation"] not in ("sample", "ar")):
+        raise CampaignError(f"{file}: {where}.autocorrelation: 'sample' or 'ar' (methods with colored errors "
+                            f"only), not {opts['autocorrelation']!r}")
     if "hold" in opts and (method != "ee-freq" or not isinstance(opts["hold"], list)
                            or not all(isinstance(h, str) for h in opts["hold"])):
         raise CampaignError(f"{file}: {where}.hold: a list of regressor names (ee-freq only), "

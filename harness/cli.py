@@ -132,6 +132,9 @@ def _add_estimate(sub) -> None:
                    help="time-domain error bounds: conventional (Eq. 15) or colored residuals (Eq. 40); "
                         "default colored for ee-smooth, conventional for ee-time")
     e.add_argument("--max-lag", type=int, default=None, help="colored errors: largest lag (default: all)")
+    e.add_argument("--autocorrelation", choices=("sample", "ar"), default="sample",
+                   help="colored errors: the residual autocorrelation, Eq. 39's estimates (default) or their "
+                        "autoregressive model ('ar': a bias term's bound honest too)")
     e.add_argument("--frequencies", default=None,
                    help="ee-freq band: auto (default: the seed's rule, 2/T to 1.2 Hz by 0.04 Hz), sidpac or "
                         "eq18 (Eq. 18, 0.20:0.04:1.20), F0:DF:F1 in Hz, or a comma list")

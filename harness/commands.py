@@ -134,7 +134,8 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     rec = read_recording(args.recording)
     equation = Equation.parse(args.dependent, args.regressors, bias=not args.no_bias and method_info(args.method).bias)
     data = DataOptions(angular_acceleration=args.angular_acceleration, reference=args.reference)
-    estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag, frequencies_hz=freqs,
+    estimator = make_estimator(args.method, errors=args.errors, max_lag=args.max_lag,
+                               autocorrelation=args.autocorrelation, frequencies_hz=freqs,
                                detrend=args.detrend, data=data)
     fit = estimator.fit(rec, equation)
     if method_info(args.method).whole_model:  # output error fits its model's terms

@@ -60,6 +60,8 @@ def _estimator(task: Task, method: str, errors: str):
     override (``module:callable`` taking the same keywords), e.g. to plant a regression."""
     kwargs = dict(errors=errors if method_info(method).supports(errors) else "conventional",
                   **estimator_options(task, method))
+    if kwargs["errors"] != "colored":
+        kwargs.pop("autocorrelation", None)  # the colored bounds' option: nothing to do for conventional ones
     factory = dict(task.method_factories).get(method)
     if factory is None:
         return make_estimator(method, **kwargs)
@@ -79,6 +81,8 @@ def estimator_options(task: Task, method: str) -> dict:
         out["detrend"] = str(opts["detrend"])
     if "max_lag" in opts:
         out["max_lag"] = int(opts["max_lag"])
+    if "autocorrelation" in opts:
+        out["autocorrelation"] = str(opts["autocorrelation"])
     if "hold" in opts:
         out["hold"] = tuple(str(h) for h in opts["hold"])
     return out

@@ -296,6 +296,10 @@ BASE = 'name = "t"\nseed = 1\nrealizations = 2\n'
     (BASE + '[grid]\nmethod = ["ee-freq"]\n[method_options.ee-freq]\nhold = "de"\n', ("hold", "regressor names")),
     (BASE + '[grid]\nmethod = ["ee-freq"]\n[method_factories]\n"ee-freq" = "os:system"\n',
      ("is code", "[plugins] allow")),
+    (BASE + '[grid]\nmethod = ["ee-freq"]\n[method_options.ee-freq]\nautocorrelation = "ar"\n',
+     ("autocorrelation", "methods with colored errors only")),
+    (BASE + '[grid]\nmethod = ["ee-smooth"]\n[method_options.ee-smooth]\nautocorrelation = "arma"\n',
+     ("autocorrelation", "'sample' or 'ar'")),
 ])
 def test_campaign_file_mistakes_are_refused_before_anything_is_written(tmp_path, capsys, text, needles):
     path = tmp_path / "c.toml"
@@ -313,6 +317,18 @@ def test_ee_freq_hold_reaches_the_estimator(tmp_path):
     campaign = load_campaign(tmp_path / "c.toml")
     task = campaign.tasks()[0]
     assert _estimator(task, "ee-freq", "conventional").hold == ("de",)
+
+
+def test_autocorrelation_option_reaches_the_colored_bounds_only(tmp_path):
+    """``[method_options.ee-smooth] autocorrelation = "ar"`` reaches the colored-bound estimator;
+    a conventional-bound task of the same method ignores it (nothing to apply it to)."""
+    from harness.campaign import load_campaign
+    from harness.tasks import _estimator
+    (tmp_path / "c.toml").write_text(BASE + '[grid]\nmethod = ["ee-smooth"]\n[method_options.ee-smooth]\n'
+                                     'autocorrelation = "ar"\n')
+    task = load_campaign(tmp_path / "c.toml").tasks()[0]
+    assert _estimator(task, "ee-smooth", "colored").autocorrelation == "ar"
+    assert _estimator(task, "ee-smooth", "conventional").autocorrelation == "sample"
 
 
 def test_workers_zero_is_refused(tmp_path, capsys):

@@ -11,6 +11,7 @@ from estimators.least_squares import SingularRegressorsError, least_squares
 from estimators.methods import make_estimator, parse_frequencies
 from estimators.regressors import Equation, RegressionData
 from maneuvers.recording import Recording
+from models.errors import OptionError
 from harness.cli import main
 
 
@@ -138,6 +139,25 @@ def test_estimate_command_on_twin_otter(tmp_path, shared_dir, method, errors, ca
     cn_beta = d["parameters"][0]["estimate"]
     assert 0.05 < cn_beta < 0.12  # directional stability of the Twin Otter
     assert "Cn_beta" in capsys.readouterr().out
+
+
+def test_autoregressive_autocorrelation_option_widens_the_bias_terms_bound(tmp_path, shared_dir):
+    """``autocorrelation='ar'`` (estimators.colored): a bias term's colored bound is no longer
+    shrunk by Eq. 39's estimates summing to zero; the choice is in ``info`` and on the command
+    line, and it needs colored errors."""
+    d = _coloured_problem(0.9)
+    sample = EquationErrorTime(errors="colored").fit(d)
+    ar = EquationErrorTime(errors="colored", autocorrelation="ar").fit(d)
+    np.testing.assert_array_equal(ar.params, sample.params)
+    assert ar.bse["bias"] > 1.5 * sample.bse["bias"]
+    assert ar.info["autocorrelation"] == "ar" and sample.info["autocorrelation"] == "sample"
+    with pytest.raises(OptionError, match="autocorrelation applies to the colored errors"):
+        EquationErrorTime(autocorrelation="ar")
+    src = shared_dir / "data" / "sidpac" / "totter_f1_017_data.mat"
+    out = tmp_path / "fit.json"
+    assert main(["estimate", "--recording", str(src), "--dependent", "Cn", "--regressors", "beta,phat,rhat,da,dr",
+                 "--method", "ee-smooth", "--autocorrelation", "ar", "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["options"]["autocorrelation"] == "ar"
 
 
 def test_estimate_errors_are_clear(tmp_path, shared_dir, capsys):

@@ -298,6 +298,10 @@ def test_colored_concatenation_of_one_maneuver_is_eq_40() -> None:
         ref = EquationErrorTime(errors="colored", max_lag=lag).fit(d)
         got = fit_concatenated([d], "colored", max_lag=lag)
         assert rel_err(got.cov, ref.cov) < 1e-10, lag
+    d = RegressionData.from_arrays(z, X, ("a", "b"), DT)  # the autoregressive autocorrelation, bias and all lags
+    ref = EquationErrorTime(errors="colored", autocorrelation="ar").fit(d)
+    got = fit_concatenated([d], "colored", autocorrelation="ar")
+    assert rel_err(got.cov, ref.cov) < 1e-10 and got.info["autocorrelation"] == "ar"
 
 
 def test_colored_concatenation_sums_per_maneuver_blocks_and_ignores_order() -> None:

@@ -423,7 +423,22 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
                 "stood_in_by": ("each surface moves by its recorded change from a start level fitted, per replay, "
                                 "within the noise of its first 0.5 s (fit_before/fit_after: surface_levels_deg; "
                                 "harness/diagnosis/levels.py)")})
+    out.append(STANDARD_ERRORS_ASSUMPTION)
     return out
+
+
+# The diagnosis's standard errors and the t values its entry rules compare are seed Eq. 40's
+# with Eq. 39's sample autocorrelation over all lags (estimators.colored). For a constant
+# column that is known to be optimistic (README, "A constant's colored-residual standard
+# error"); the rules were set against these values, so the output says so.
+STANDARD_ERRORS_ASSUMPTION = {
+    "item": "standard errors",
+    "missing": "-",
+    "stood_in_by": ("seed Eq. 40 with the residuals' sample autocorrelation (Eq. 39, all lags), stationary "
+                    "residuals assumed; for a constant (a sensor bias, a coefficient offset) it is too small, by "
+                    "about 2 when the sensor's error wanders slowly (tau about 1 s on a 30 s record); the entry "
+                    "rules' t thresholds (5 and 6) were set against these values"),
+}
 
 
 # A recording's mass or inertia this far from the model's is named in the model-mass assumption.
