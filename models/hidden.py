@@ -306,20 +306,26 @@ def needs_copy(effects: tuple[HiddenEffect, ...]) -> bool:
     return any(e.effect in AERO_TERMS or e.effect == "control_delay" for e in effects)
 
 
+# The trim references an added term is written about (alpha and the surfaces in rad, V in ft/s).
+REFERENCE_KEYS = ("alpha", "dV", "de", "da", "dr")
+
+
 def hidden_root(aircraft, condition, refs: dict[str, float] | None = None):
     """Write the aircraft copy with ``aircraft.hidden``'s aerodynamic effects; ``(root, name)``.
 
     α_ref (and the other trim references) are the nominal aircraft's trim values at
     ``condition`` unless ``refs`` or an effect's ``reference`` gives them, so an added
-    α-polynomial vanishes, with its slope, at the trim point.
+    α-polynomial vanishes, with its slope, at the trim point. With every one of
+    :data:`REFERENCE_KEYS` in ``refs`` no trim is made.
     """
     from models.aircraft import load_fdm, model_xml, nominal_tree
     from models.jsbsim_root import cached_root
     from models.trim import trim
     nominal = replace(aircraft, variant="nominal", hidden=())
-    tp = trim(load_fdm(nominal, 1 / 120), nominal, condition)
-    base = {"alpha": tp.alpha_rad, "dV": tp.V_fps, "de": tp.de_rad, "da": tp.da_rad, "dr": tp.dr_rad}
-    base.update(refs or {})
+    base = dict(refs or {})
+    if not all(k in base for k in REFERENCE_KEYS):  # the trim only when some reference is not given
+        tp = trim(load_fdm(nominal, 1 / 120), nominal, condition)
+        base = {"alpha": tp.alpha_rad, "dV": tp.V_fps, "de": tp.de_rad, "da": tp.da_rad, "dr": tp.dr_rad} | base
     tree = nominal_tree(aircraft.model)
     add_hidden_aerodynamics(tree, tuple(aircraft.hidden), base["alpha"], nominal.surfaces, base)
     name = f"{aircraft.name}-hidden"

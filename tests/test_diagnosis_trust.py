@@ -542,6 +542,44 @@ def test_a_sensor_suspicion_withholds_only_what_it_could_imitate():
     assert not unknown.selected and unknown.details["sensor_rival"] == "scale_q"
 
 
+def test_a_suspects_contested_rival_is_asked_too():
+    """term_rules.withhold_ambiguous: an α vane ahead of the c.g. that the kinematics cannot tell
+    from an α lag (``contested``) brings the lag in as a suspect at its own estimate: a C_Z,α
+    change the vane offset hardly imitates is withheld when the lag would imitate half of it,
+    and kept (with both suspects in its reason) when neither would."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_rules import Contest
+    from harness.diagnosis.term_rules import IMITATION_SHARE, withhold_ambiguous
+    kin = SimpleNamespace(parameters={"vane_alpha_x": SimpleNamespace(channel="alpha"),
+                                      "skew_alpha": SimpleNamespace(channel="alpha")},
+                          selection=SimpleNamespace(params={}, terms=[
+                              SimpleNamespace(name="vane_alpha_x", estimate=16.0, t=10.0),
+                              SimpleNamespace(name="skew_alpha", estimate=0.04, t=2.0)]))
+    contested = {"vane_alpha_x": Contest("skew_alpha", 0.91, 1.0, (0.088, 9.1))}
+    asked = []
+
+    def imitated(share_of_skew):
+        def imitate(c, name, at=None):
+            asked.append((name, at))
+            return 0.05 if name == "vane_alpha_x" else share_of_skew * 0.69
+        return imitate
+
+    def term():
+        return Candidate("coefficient_error", "lon", "CZ", "CZ_alpha", -4.99, 0.11, 6.4, 0.3, "per rad",
+                         "stepwise on the CZ mismatch", selected=True, reason="entered", details={"change": 0.69})
+
+    withheld, kept, alone = term(), term(), term()
+    withhold_ambiguous([withheld], kin, imitated(IMITATION_SHARE), contested=contested)
+    assert not withheld.selected and withheld.details["sensor_rival"] == "skew_alpha"
+    assert ("skew_alpha", (0.088, 0.088 / 9.1)) in asked
+    withhold_ambiguous([kept], kin, imitated(0.01), contested=contested)
+    assert kept.selected and "vane_alpha_x (t = 10.0)" in kept.reason and "skew_alpha (t = 9.1)" in kept.reason
+    withhold_ambiguous([alone], kin, imitated(IMITATION_SHARE))  # without the contest only the vane is asked
+    assert alone.selected and "skew_alpha" not in alone.reason
+
+
 def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the_mismatch(monkeypatch):
     """stepwise_axes.vane_noise_columns: the column −C_m,α·e (e = −w_gust/V from the kinematic
     residual) is offered to C_m's fit when, fitted alone, it takes at least VANE_NOISE_SHARE
@@ -1423,3 +1461,27 @@ def test_a_still_angle_s_error_is_untestable_where_only_the_airspeed_change_show
     assert steady_vane(name, p) == vane
     if vane:
         assert "never drove" in steady_vane_reason(vane) and "V̇·b" in steady_vane_reason(vane)
+
+
+def test_the_augmented_model_is_written_where_the_model_cannot_be_trimmed(tmp_path):
+    """augmented.write_model: a model that cannot be trimmed at the recording's start (its
+    replays could not be made) still gets its augmented XML, the added terms written about the
+    recording's own first α, V and surface positions, and the note says so (a pa28 recording
+    at 190 ft/s, which the package's pa28 cannot fly level, had stopped the whole diagnosis
+    with the trim's error at this last step). Without those references the trim's error stands."""
+    from models.aircraft import Aircraft
+    from models.hidden import HiddenEffect, hidden_root
+    from models.replay import InitialCondition
+    from models.trim import TrimError
+
+    from harness.diagnosis.augmented import write_model
+    aircraft, ic = Aircraft(), InitialCondition(h_ft=10_000.0, V_fps=90.0, alpha_rad=0.2)
+    added = (HiddenEffect("coefficient_error", 0.5, coefficient="CZ", regressor="alpha"),)
+    start = {"alpha": 0.2, "dV": 90.0, "de": -0.05, "da": 0.0, "dr": 0.0}
+    info = write_model(tmp_path, aircraft, ic, added, start_refs=start)
+    assert "cannot be trimmed at the recording's start" in info["note"] and "cannot trim" in info["note"]
+    assert (tmp_path / info["augmented_xml"]).is_file()
+    with pytest.raises(TrimError):
+        write_model(tmp_path / "again", aircraft, ic, added)
+    root, name = hidden_root(Aircraft(hidden=added), ic.condition(), start)  # every reference given: no trim
+    assert (root / "aircraft" / name / f"{name}.xml").is_file()

@@ -95,7 +95,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     note_untested_coupling(cands, p)
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
     imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
-    withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin))
+    withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin), contested)
     if turbulent:
         withhold_in_turbulence(cands)
     else:

@@ -412,11 +412,25 @@ def sensor_models(findings: list[Candidate]) -> list[dict]:
     return out
 
 
+def recording_start_references(p: Prepared, ic) -> dict[str, float]:
+    """The recording's own first α, V and surface positions (rad, ft/s), in the keys of
+    :data:`models.hidden.REFERENCE_KEYS`: what added terms are written about when the model
+    cannot be trimmed at the recording's start."""
+    return {"alpha": float(ic.alpha_rad), "dV": float(ic.V_fps),
+            **{s: float(p.smooth[s][0]) if s in p.smooth else 0.0 for s in SURFACES}}
+
+
 def write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ...],
-                other: list[dict] | None = None, refs: dict | None = None) -> dict:
+                other: list[dict] | None = None, refs: dict | None = None,
+                start_refs: dict | None = None) -> dict:
     """Copy the augmented aircraft (XML) into ``out/model``; sensor effects (and a structural
     mode's notch, the turbulence model) are listed in ``sensors.json`` beside it (they change
-    what the instruments record, or the air the aircraft flies through, not the aircraft)."""
+    what the instruments record, or the air the aircraft flies through, not the aircraft).
+
+    The added terms are written about the model's trim at the recording's start (``refs``
+    when the calibration gave them). Where the model cannot be trimmed there (the replays
+    could not be made either), they are written about ``start_refs``, the recording's own
+    first α, V and surface positions, and the returned note says so."""
     dest = out / "model"
     dest.mkdir(parents=True, exist_ok=True)
     terms = [e.describe() | {"parameter": e.parameter} for e in added]
@@ -426,10 +440,18 @@ def write_model(out: Path, aircraft: Aircraft, ic, added: tuple[HiddenEffect, ..
     if not any(not e.effect.startswith("sensor_") for e in added):
         return {"base": aircraft.model, "augmented_xml": None, "terms": terms, **outside,
                 "note": "no aerodynamic or actuator term was added; the model's XML is unchanged"}
-    root, name = hidden_root(replace(aircraft, hidden=added), ic.condition(), refs)
+    where = ""
+    try:
+        root, name = hidden_root(replace(aircraft, hidden=added), ic.condition(), refs)
+    except TrimError as exc:
+        if start_refs is None:
+            raise
+        root, name = hidden_root(replace(aircraft, hidden=added), ic.condition(), {**start_refs, **(refs or {})})
+        where = (f"; the model cannot be trimmed at the recording's start ({exc}), so the added terms are written "
+                 "about the recording's first alpha, V and surface positions instead of the model's trim")
     src = root / "aircraft" / name / f"{name}.xml"
     target = dest / f"{aircraft.name}-diagnosed.xml"
     write_atomic(target, lambda fh: fh.write(src.read_bytes()))
     return {"base": aircraft.model, "augmented_xml": str(target.relative_to(out)), "terms": terms, **outside,
             "note": ("a control delay is a property (sidbench/<surface>-delay-delta-rad) the sidbench flight loop "
-                     "drives; the aerodynamic terms fly in any JSBSim")}
+                     "drives; the aerodynamic terms fly in any JSBSim" + where)}

@@ -15,7 +15,7 @@ from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis.analysis import analyse
 from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_all, refine_in_the_loop, replay_before,
                                          sensor_models, terms_of, unsupported_in_the_loop, with_calibration,
-                                         write_model)
+                                         recording_start_references, write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.mode_model import attach_mode_models
@@ -269,7 +269,8 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         located["outputs"]["validation"] = located_paragraph(av, fb_v, "validation")["outputs"]["validation"]
     timing["total"] = time.perf_counter() - t0
     model_info = write_model(out, aircraft, ic, added, sensor_models(modelled),
-                             calibration.get("references") if calibration["used"] else None)
+                             calibration.get("references") if calibration["used"] else None,
+                             start_refs=recording_start_references(p, ic))
     result = {
         "findings": [with_calibration(finding_dict(f, fits_b, fits_a, checks.get(id(f))), calibration)
                      for f in findings] or [none_finding(a, fits_b)],

@@ -651,7 +651,7 @@ def _named(rival: str | tuple[str, ...]) -> str:
 
 def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=None,
                        column_sensors: dict[str, tuple[str, ...]] | None = None,
-                       euler_lag: EulerLag | None = None) -> None:
+                       euler_lag: EulerLag | None = None, contested: dict | None = None) -> None:
     """Deselect coefficient errors the kinematics cannot tell from a sensor error on the
     channel they are built on (:data:`AMBIGUOUS_T`) and that the sensor error, at a size the
     kinematics allow, would imitate (``imitated``, :func:`imitation`; half the change); the
@@ -676,14 +676,23 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     ``euler_lag`` (:func:`euler_lag_estimate`), unless the kinematics rule it out, is asked of
     every rate-shaped moment term (C_m,α̇ and the rate derivatives of C_l, C_m, C_n) the same
     way: withheld when the rates' derivatives lagging the moments by any lag it allows
-    imitate half its change."""
+    imitate half its change.
+
+    A suspect the kinematics cannot tell from a rival (``contested``,
+    :func:`sensor_rules.contested_parameters`) brings the rival in as a suspect of its own
+    channel, at the rival's own estimate (an α vane 15 ft ahead of the c.g. and an 80 ms α
+    lag both follow q on a pitch maneuver: a pa28 recording whose α was 80 ms late named a
+    C_Z,α change of +0.69 that only the vane offset, imitating −0.16 of it, had been asked
+    about)."""
 
     asked: set[tuple[int, str]] = set()  # (term, rival) found not to explain it
+    contest_at: dict[str, tuple[float, float]] = {}  # a contested suspect's rival: its own (estimate, s.e.)
 
     def explains(c: Candidate, rival: str, t: float) -> bool:
         if (id(c), rival) in asked:
             return False  # asked already (the regressor's sensor and the coefficient's)
-        size = None if imitated is None else imitated(c, rival)
+        at = contest_at.get(rival) if isinstance(rival, str) else None
+        size = None if imitated is None else imitated(c, rival, at) if at else imitated(c, rival)
         change = abs(term_change(c))
         if size is None or size >= IMITATION_SHARE * change:
             return True
@@ -693,19 +702,31 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
         c.reason += (f"; the kinematics {asks} {_named(rival)} (t = {t:.1f}), which would imitate at most "
                      f"{size:.2g} of this change of {change:.3g}")
         return False
-    suspects: dict[str, tuple[str, float]] = {}
+    suspects: dict[str, list[tuple[str, float]]] = {}  # each channel's suspected errors, largest t first
     for name, sp in kin.parameters.items():
         found = kinematic_estimate(kin, name)
-        if found is not None and name.split("_", 1)[0] in AMBIGUOUS_KINDS:
-            t = found[1]
-            if t >= AMBIGUOUS_T and t > suspects.get(sp.channel, ("", 0.0))[1]:
-                suspects[sp.channel] = (name, t)
+        if found is not None and name.split("_", 1)[0] in AMBIGUOUS_KINDS and found[1] >= AMBIGUOUS_T:
+            suspects.setdefault(sp.channel, []).append((name, found[1]))
+    for name, contest in (contested or {}).items():
+        own, other = kin.parameters.get(name), kin.parameters.get(contest.rival)
+        solo = contest.rival_estimate or kinematic_estimate(kin, contest.rival)
+        if (own is None or other is None or solo is None or not solo[0] or solo[1] < AMBIGUOUS_T
+                or contest.rival.split("_", 1)[0] not in AMBIGUOUS_KINDS
+                or name not in [n for n, _ in suspects.get(own.channel, [])]):
+            continue
+        if contest.rival not in [n for n, _ in suspects.get(other.channel, [])]:
+            suspects.setdefault(other.channel, []).append((contest.rival, solo[1]))
+            contest_at[contest.rival] = (solo[0], abs(solo[0]) / solo[1])
+    for found in suspects.values():
+        found.sort(key=lambda r: -r[1])
     unit = suspected_estimate(kin, GYRO_UNIT)  # the rate gyros' common skew, beside each one's own
     units = {g: (GYRO_UNIT, unit[1]) for g in GYROS
              if unit is not None and unit[1] >= AMBIGUOUS_T and f"skew_{g}" in unit_members(kin, GYRO_UNIT)}
 
     def rivals_of(channel: str | None) -> list[tuple[str, float]]:
-        return [r for r in (suspects.get(channel or ""), units.get(channel or ""))
+        """Every suspected error of the channel (a vane ahead of the c.g. and the vane's lag,
+        which the kinematics may not tell apart: each is asked), then the gyros' common skew."""
+        return [r for r in suspects.get(channel or "", []) + [units.get(channel or "")]
                 if r is not None and not euler_lead(kin, r[0], euler_lag)]
 
     def unruled_skews(channel: str | None) -> list[tuple[str, float]]:
