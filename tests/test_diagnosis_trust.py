@@ -155,6 +155,35 @@ def test_a_term_the_calibration_sizes_at_nothing_is_withdrawn():
     assert id(strong) not in checks
 
 
+def test_a_term_that_fails_its_entry_rules_at_the_calibrated_size_is_withdrawn():
+    """augmented.unsupported_in_the_loop: the practical share and the suspect's imitation are
+    asked again at the calibrated size. A C_m,δe change of −0.022 explaining 13 % of C_m's
+    excursion, calibrated to −0.0064 (3.8 %), and a C_m,α̇ of 1.73 calibrated to 0.50, of which
+    the Euler half-step imitates up to 0.39, are withdrawn; a change calibrated to 80 % of its
+    equation-error size stands."""
+    from harness.diagnosis.augmented import unsupported_in_the_loop
+    from harness.diagnosis.evidence import Candidate
+    small = Candidate("coefficient_error", "pitch", "Cm", "Cm_de", -0.608, 0.0009, -24.4, 0.6, "per rad",
+                      "stepwise on the Cm mismatch", selected=True, reason="entered",
+                      details={"change": -0.022, "excursion_share": 0.13})
+    imitated = Candidate("unsteady_alphadot", "pitch", "Cm", "Cm_alphadot", 1.73, 0.024, 73.0, 0.99, "per rad",
+                         "stepwise on the Cm mismatch", selected=True, reason="entered",
+                         details={"excursion_share": 0.3, "sensor_suspect": {"parameter": "euler_lag",
+                                                                             "imitates_at_most": 0.39,
+                                                                             "change": 1.73}})
+    kept = Candidate("coefficient_error", "pitch", "Cm", "Cm_qhat", -8.5, 0.04, -30.0, 0.5, "per rad",
+                     "stepwise on the Cm mismatch", selected=True, reason="entered",
+                     details={"change": -5.5, "excursion_share": 0.2})
+    sized = {"Cm_de": {"size": -0.0064, "std_error": 0.0009}, "Cm_alphadot": {"size": 0.50, "std_error": 0.034},
+             "Cm_qhat": {"size": -4.4, "std_error": 0.05}}
+    checks: dict = {}
+    assert unsupported_in_the_loop([small, imitated, kept], {"used": True, "findings": sized}, checks) == [
+        small, imitated]
+    assert "3.8 % of the coefficient's excursion" in checks[id(small)]["reason"]
+    assert "euler_lag" in checks[id(imitated)]["reason"] and "fails a rule it entered by" in checks[id(imitated)][
+        "reason"]
+
+
 def test_a_term_the_calibration_sizes_with_the_other_sign_is_withdrawn():
     """augmented.unsupported_in_the_loop: a coefficient change the equation error puts at +0.96
     and the calibration, clearly away from zero, at −0.16 ± 0.02 (an α-vane scale read as a

@@ -13,6 +13,7 @@ import pandas as pd
 from scipy import signal
 
 from harness.atomic import write_atomic, write_text_atomic
+from harness.diagnosis import candidates as cand
 from harness.diagnosis import levels, refine
 from harness.diagnosis.along import interior
 from harness.diagnosis.analysis import analyse
@@ -21,6 +22,7 @@ from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.mode_model import driven_modes, mode_outputs, with_mode_band
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
 from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
+from harness.diagnosis.term_rules import IMITATION_SHARE
 from harness.diagnosis.validation import after_mismatch
 from harness.diagnosis.verdict import check_time_base
 from harness.executors import LocalPool
@@ -329,7 +331,15 @@ def unsupported_in_the_loop(findings: list[Candidate], calibration: dict, checks
     error the equation error read as a term: a 10 % α-vane scale on a c172x pitch maneuver,
     which the kinematics could not see (k 0.03 ± 0.11), made the model along the vane a C_Z,α
     change of +0.96 (the slope times −k/(1+k)); the aircraft flown in the loop, matched on
-    a_z, put it at −0.16 ± 0.02 (probe 38)."""
+    a_z, put it at −0.16 ± 0.02 (probe 38).
+
+    The rules a term entered by are asked again at its calibrated size: it must still explain
+    :data:`candidates.PRACTICAL_SHARE` of its coefficient's excursion (its equation-error share
+    scaled by the sizes' ratio), and the sensor error the kinematics suspect must still imitate
+    less than :data:`term_rules.IMITATION_SHARE` of it. Noise-free three-axis recordings of the
+    package's c182 and pa28, flown by an independent script, had named a C_m,δe change the
+    calibration put at −0.0064 (equation error −0.022: 1 % of the model's −0.59) and a C_m,α̇
+    of 0.50 (equation error 1.73) that JSBSim's Euler half-step imitates up to 0.39."""
     if not calibration.get("used"):
         return []
     sized = calibration.get("findings") or {}
@@ -340,18 +350,35 @@ def unsupported_in_the_loop(findings: list[Candidate], calibration: dict, checks
             continue
         ee = f.details.get("change", f.estimate)
         weak = abs(own["size"]) < CALIBRATED_MIN_Z * own["std_error"]
-        if not weak and own["size"] * ee >= 0:
-            continue
         why = (f"within {CALIBRATED_MIN_Z:g} standard errors of no change" if weak else
-               "of the opposite sign")
+               "of the opposite sign" if own["size"] * ee < 0 else _too_small_calibrated(f, own["size"], ee))
+        if not why:
+            continue
         before = checks.get(id(f)) or {}
         checks[id(f)] = {**before, "status": "unsupported", "validation_status": before.get("status", "not checked"),
                          "reason": (f"the calibration (output error, JSBSim in the loop) sizes it "
                                     f"{own['size']:.3g} ± {own['std_error']:.2g}, {why} (equation error: {ee:.3g}"
-                                    f" ± {f.std_error:.2g}): the "
-                                    "mismatch it fitted is not one the augmented model flies")}
+                                    f" ± {f.std_error:.2g}): " + (
+                                        "the mismatch it fitted is not one the augmented model flies"
+                                        if weak or own["size"] * ee < 0 else
+                                        "at the size the augmented model flies it fails a rule it entered by"))}
         out.append(f)
     return out
+
+
+def _too_small_calibrated(f: Candidate, size: float, ee: float) -> str:
+    """Why a finding no longer passes its entry rules at its calibrated ``size`` (equation
+    error ``ee``), or "" (:func:`unsupported_in_the_loop`)."""
+    ratio = abs(size / ee) if ee else 1.0
+    share = f.details.get("excursion_share")
+    if share is not None and share * ratio < cand.PRACTICAL_SHARE:
+        return (f"so small that it explains {100 * share * ratio:.1f} % of the coefficient's excursion (under "
+                f"{100 * cand.PRACTICAL_SHARE:.0f} %)")
+    suspect = f.details.get("sensor_suspect")
+    if suspect and suspect["imitates_at_most"] >= IMITATION_SHARE * abs(size):
+        return (f"so small that {suspect['parameter']}, which the kinematics do not rule out, would imitate "
+                f"{suspect['imitates_at_most']:.2g} of it (half or more)")
+    return ""
 
 
 def with_calibration(d: dict, calibration: dict) -> dict:

@@ -408,9 +408,9 @@ def aero_candidates(selections: dict, delays: dict, dt: float,
             reason = ("entered" if sel else _impractical_reason(share) if t.selected else "not entered")
             out.append(Candidate(term.effect, cand.AXIS_NAME[axis], axis, term.parameter, est, se, t.t, t.gain,
                                  term.units, f"stepwise on the {axis} mismatch", sel, reason,
-                                 {"change": t.estimate, "model_over_maneuver": term.details["model_value"],
-                                  "model_at_trim": term.details["trim_value"]}
-                                 if term.effect == "coefficient_error" else {}))
+                                 ({"change": t.estimate, "model_over_maneuver": term.details["model_value"],
+                                   "model_at_trim": term.details["trim_value"]}
+                                  if term.effect == "coefficient_error" else {}) | {"excursion_share": share}))
     for s, rows in delay_seen.items():
         scan = delays[s]
         # significance from the stepwise entry of the delay column (its coefficient is τ);
