@@ -605,6 +605,7 @@ def test_a_suspects_contested_rival_is_asked_too():
     assert ("skew_alpha", (0.088, 0.088 / 9.1)) in asked
     withhold_ambiguous([kept], kin, imitated(0.01), contested=contested)
     assert kept.selected and "vane_alpha_x (t = 10.0)" in kept.reason and "skew_alpha (t = 9.1)" in kept.reason
+    assert kept.details["sensor_suspect"]["parameter"] == "vane_alpha_x"  # the one that reaches furthest (0.05)
     withhold_ambiguous([alone], kin, imitated(IMITATION_SHARE))  # without the contest only the vane is asked
     assert alone.selected and "skew_alpha" not in alone.reason
 

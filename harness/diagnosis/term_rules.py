@@ -697,7 +697,9 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
         if size is None or size >= IMITATION_SHARE * change:
             return True
         asked.add((id(c), rival))
-        c.details["sensor_suspect"] = {"parameter": rival, "imitates_at_most": size, "change": change}
+        kept = c.details.get("sensor_suspect")
+        if kept is None or size > kept["imitates_at_most"]:  # the suspect that reaches furthest
+            c.details["sensor_suspect"] = {"parameter": rival, "imitates_at_most": size, "change": change}
         asks = "suspect" if t >= AMBIGUOUS_T else "do not rule out"
         c.reason += (f"; the kinematics {asks} {_named(rival)} (t = {t:.1f}), which would imitate at most "
                      f"{size:.2g} of this change of {change:.3g}")
