@@ -1515,3 +1515,20 @@ def test_the_augmented_model_is_written_where_the_model_cannot_be_trimmed(tmp_pa
         write_model(tmp_path / "again", aircraft, ic, added)
     root, name = hidden_root(Aircraft(hidden=added), ic.condition(), start)  # every reference given: no trim
     assert (root / "aircraft" / name / f"{name}.xml").is_file()
+
+
+def test_a_recording_through_the_vertical_is_refused_for_that_reason():
+    """verdict.check_attitude_range: a record whose pitch attitude comes within 5 deg of the
+    vertical is refused naming the attitude and the time (the Euler kinematics are singular
+    there; an F-16 pull-up that went over the top had been refused for its time column)."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.verdict import DiagnosisError, check_attitude_range
+    t = np.arange(0, 10, 0.02)
+    level = SimpleNamespace(name="identification", t=t, raw={"theta": np.radians(30 * np.sin(t))})
+    check_attitude_range(level)
+    over = SimpleNamespace(name="identification", t=t, raw={"theta": np.radians(89.7 * np.sin(t / 2))})
+    with pytest.raises(DiagnosisError, match=r"theta = 89\.7 deg \(at t = 3\.14 s\), within 5 deg of the vertical"):
+        check_attitude_range(over)

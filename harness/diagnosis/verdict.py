@@ -316,16 +316,48 @@ LIFT_FACTOR = 1.5
 GEOMETRY_FACTOR = 1.25
 
 
+# How close to vertical (|θ| of 90°) a recording may pitch. The Euler-angle kinematics the
+# diagnosis checks its sensors and its time column with (φ̇ = p + tanθ(q sinφ + r cosφ), ψ̇ =
+# (q sinφ + r cosφ)/cosθ) are singular at the vertical, where φ and ψ flip by 180° in a
+# sample: an F-16 pull-up that went over the top (θ to 90°, α to 132°) was refused as having
+# a time column 1.36 times too slow. Within 5° of it tanθ amplifies the gyros' noise elevenfold.
+MAX_PITCH_ATTITUDE_DEG = 85.0
+
+
+def check_attitude_range(p: Prepared) -> None:
+    """Refuse a recording that pitches within 90 − :data:`MAX_PITCH_ATTITUDE_DEG` degrees of
+    the vertical: its Euler angles are singular there, and the kinematic checks cannot be made.
+
+    Raises
+    ------
+    DiagnosisError
+        Naming the maneuver, the largest |θ| and where it occurs.
+    """
+    theta = p.raw.get("theta")
+    if theta is None or not theta.size:
+        return
+    i = int(np.argmax(np.abs(theta)))
+    if np.degrees(abs(theta[i])) < MAX_PITCH_ATTITUDE_DEG:
+        return
+    raise DiagnosisError(
+        f"the {p.name} recording pitches to theta = {np.degrees(theta[i]):.1f} deg (at t = {p.t[i]:.2f} s), within "
+        f"{90 - MAX_PITCH_ATTITUDE_DEG:g} deg of the vertical, where Euler angles are singular (phi and psi flip by "
+        "180 deg): the diagnosis's kinematic checks of the sensors and the time column rest on the Euler angles and "
+        "cannot be made there. Give it the part of the record before the aircraft passes the vertical")
+
+
 def check_time_base(p: Prepared) -> None:
     """Refuse a recording whose time column disagrees with its gyros
     (:func:`kinematics.time_base_problem`): every derivative the diagnosis takes would be off
-    by the same factor, and each coefficient with it.
+    by the same factor, and each coefficient with it. A recording that pitches through the
+    vertical is refused first, with that reason (:func:`check_attitude_range`).
 
     Raises
     ------
     DiagnosisError
         Naming the maneuver, the ratio found and what to check.
     """
+    check_attitude_range(p)
     why = time_base_problem(p)
     if why:
         raise DiagnosisError(f"the {p.name} recording's time column cannot be right: {why}")
