@@ -254,6 +254,20 @@ def xml_surface_properties(model: str) -> dict[str, str]:
     return out
 
 
+def other_fcs_properties(model: str, surfaces: dict[str, str]) -> tuple[str, ...]:
+    """The ``fcs/`` properties an aircraft XML's aerodynamics read beyond the three surfaces it
+    is driven by (``surfaces``) and the magnitudes JSBSim ties to them (``fcs/mag-*``): flaps,
+    speed brakes, the F-16's leading-edge flap and flaperons. The project flies and evaluates the
+    model with its FCS disabled, so these stay where trim put them; a recording flown with the
+    FCS on may have moved them."""
+    aero = ET.parse(model_xml(model)).getroot().find("aerodynamics")
+    read = sorted({(el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar")}
+                  if aero is not None else set())
+    primary = set(surfaces.values())
+    return tuple(p for p in read if p.startswith("fcs/") and p not in primary
+                 and not (p.startswith("fcs/mag-") and p.replace("fcs/mag-", "fcs/") in primary))
+
+
 def new_fdm(root: Path | None, name: str, dt: float) -> jsbsim.FGFDMExec:
     """Create a silent JSBSim instance and load aircraft ``name`` from ``root``."""
     # JSBSim's banner is printed by the constructor unless its (process-wide) debug level

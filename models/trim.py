@@ -270,6 +270,14 @@ def _solve_level(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCon
     alpha0 = float(np.clip(fdm["inertia/mass-slugs"] * G0_FPS2 / max(qS, 1e-9) / 4.5, 0.0, 0.5))
     lo = [_ALPHA_BOUNDS[0], _DE_BOUNDS[0], 0.0]
     hi = [_ALPHA_BOUNDS[1], _DE_BOUNDS[1], 1.0]
+    start = _level_residual(fdm, aircraft, condition, hold, [alpha0, 0.0, 0.5])
+    if not np.all(np.isfinite(start)):
+        # no equilibrium can be searched from accelerations that are not numbers (scipy would
+        # stop with a ValueError, an internal error to the user; seen on an augmented F-16 whose
+        # added terms had been sized from a recording flown with its FCS on)
+        raise TrimError(_where(aircraft, condition) + f": the model's accelerations are not finite at alpha = "
+                        f"{math.degrees(alpha0):.1f} deg, stabilator 0, throttle 0.5 (its aerodynamics, or a term "
+                        "added to them, give no number there)")
     sol = least_squares(lambda x: _level_residual(fdm, aircraft, condition, hold, x), [alpha0, 0.0, 0.5],
                         bounds=(lo, hi), xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200)
     _level_residual(fdm, aircraft, condition, hold, sol.x)

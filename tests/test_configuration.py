@@ -146,6 +146,19 @@ def test_no_equilibrium_names_the_condition_and_why():
         trim(load_fdm(aircraft, 1 / 120), aircraft, FlightCondition("slow", 30_000.0, 200.0))
 
 
+def test_accelerations_that_are_not_numbers_fail_the_trim_by_name(monkeypatch):
+    """models.trim._solve_level: a model whose accelerations are not finite where the search
+    starts (an augmented copy's added terms, say) fails its trim with a TrimError naming the
+    condition and why, not scipy's ValueError (an internal error to the user)."""
+    from models import trim as trim_module
+    aircraft = Aircraft()
+    fdm = load_fdm(aircraft, 1 / 120)
+    fdm.run_ic()
+    monkeypatch.setattr(trim_module, "_level_residual", lambda *args: [math.nan, 0.0, 0.0])
+    with pytest.raises(TrimError, match="accelerations are not finite at alpha"):
+        trim_module._solve_level(fdm, aircraft, condition_for("f16", None), {})
+
+
 def test_737_flies_clean():
     aircraft = Aircraft("737")
     fdm = load_fdm(aircraft, 1 / 120)

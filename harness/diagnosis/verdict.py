@@ -13,7 +13,7 @@ from harness.diagnosis.kinematics import time_base_problem
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
 from harness.diagnosis.sensor_rules import steady_vane, steady_vane_reason
-from models.aircraft import Aircraft
+from models.aircraft import Aircraft, other_fcs_properties
 from models.constants import SURFACES
 
 
@@ -455,8 +455,29 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
                 "stood_in_by": ("each surface moves by its recorded change from a start level fitted, per replay, "
                                 "within the noise of its first 0.5 s (fit_before/fit_after: surface_levels_deg; "
                                 "harness/diagnosis/levels.py)")})
+    held = held_surfaces_assumption(aircraft, a.aero.trim)
+    if held:
+        out.append(held)
     out.append(STANDARD_ERRORS_ASSUMPTION)
     return out
+
+
+def held_surfaces_assumption(aircraft: Aircraft, trim) -> dict | None:
+    """The model's other FCS-driven surfaces its aerodynamics read, held where trim put them
+    (:func:`models.aircraft.other_fcs_properties`), as an assumption: a recording flown with its
+    FCS on may have moved them. The F-16 flown with its FCS on by an independent script
+    (probe 53) moved its leading-edge flap at α = 5° and its flaperons with the aileron; the
+    mismatch they made was named as C_Z,α̇, C_Z,q̂ and moment-reference terms."""
+    props = other_fcs_properties(aircraft.model, aircraft.surfaces)
+    if not props:
+        return None
+    positions = (getattr(trim, "configuration", None) or {}).get("positions", {})
+    values = ", ".join(f"{p} {positions[p]:.3g}" if p in positions else p for p in props)
+    return {"item": "other control surfaces", "missing": "their positions (not recording-format channels)",
+            "stood_in_by": (f"held where the model's trim put them, its FCS disabled: {values}; a recording flown "
+                            "with the FCS on may have moved them (the F-16's leading-edge flap switches at alpha "
+                            "= 5 deg, its flaperons follow the aileron), and the mismatch they make would be read "
+                            "as terms on alpha, the surfaces or the moment reference")}
 
 
 # The diagnosis's standard errors and the t values its entry rules compare are seed Eq. 40's
