@@ -95,6 +95,10 @@ class Aircraft:
     rp_shift_in: float = 8.0
     hidden: tuple = ()  # models.hidden.HiddenEffect: concealed physics for the discrepancy diagnosis
     aero_reference: str = "project"
+    # the surfaces the FCS moves beside de, da, dr (models.configuration.SECONDARY_SURFACE_LAWS):
+    # "held" where trim put them (the FCS disabled), or "fcs" moved by the FCS's laws where the
+    # model is evaluated along a recording (models.replay.aero_along; its flights keep them held)
+    secondary_surfaces: str = "held"
 
     def __post_init__(self) -> None:
         if self.aero_reference not in AERO_REFERENCES:
@@ -114,6 +118,8 @@ class Aircraft:
                                  "is only built for the project's models")
         if self.variant not in VARIANTS:
             raise AircraftError(f"unknown variant {self.variant!r}; choose one of {VARIANTS}")
+        if self.secondary_surfaces not in ("held", "fcs"):
+            raise AircraftError(f"secondary_surfaces must be 'held' or 'fcs', not {self.secondary_surfaces!r}")
 
     @property
     def surfaces(self) -> dict[str, str]:

@@ -128,3 +128,27 @@ def configuration_record(fdm: jsbsim.FGFDMExec, config: Configuration, written: 
 SCHEDULED_SURFACES: dict[str, dict[str, tuple[float, ...]]] = {
     "f16": {"fcs/lef-pos-rad": (0.262, 0.0, 0.436, -0.0349)},
 }
+
+
+# The surfaces an aircraft's FCS moves in flight from its states and its pilot's surfaces, beside
+# the three the recording carries (recording-format: de, da, dr): the laws by which JSBSim's
+# f16.xml moves them, for evaluating a recording flown with the FCS on (the project flies and
+# evaluates the model with its FCS disabled, where they stay at trim). From f16.xml: the
+# leading-edge flap is the switch <fcs/lef-pos-rad> (airborne, gear up: 0.436 rad above α =
+# 0.2618 rad, 0.262 above 0.0873, −0.0349 above Mach 0.9, else 0); the flaperons' mix
+# <fcs/flaperon-mix-rad> = 1.4324 (clip(−tef − a) + clip(tef − a)), clip to ±1, with the aileron's
+# speed-compensated command a = (δa / 0.375)(1 − 0.85 M) (the scheduled gain 1 → 0.15 over Mach
+# 0 → 1) and the trailing-edge flap's normalised position tef = 2.864789 × (0.349 rad below 250
+# kt calibrated, −0.0349 above Mach 0.9, else 0). The kinematic rate limits (the aileron's 0.3 s,
+# the flaps' 3 s full travel) are left out.
+def f16_secondary_surfaces(alpha_rad: float, mach: float, vc_kts: float, da_rad: float) -> dict[str, float]:
+    """The F-16's leading-edge flap and flaperon mix (rad) as its FCS sets them at a state."""
+    lef = 0.436 if alpha_rad > 0.2618 else 0.262 if alpha_rad > 0.0873 else -0.0349 if mach > 0.9 else 0.0
+    gain = 1.0 - 0.85 * min(max(mach, 0.0), 1.0)
+    a = min(max(da_rad / 0.375, -1.0), 1.0) * gain
+    tef = 2.864789 * (0.349 if vc_kts < 250.0 else -0.0349 if mach > 0.9 else 0.0)
+    mix = 1.4324 * (min(max(-tef - a, -1.0), 1.0) + min(max(tef - a, -1.0), 1.0))
+    return {"fcs/lef-pos-rad": lef, "fcs/flaperon-mix-rad": mix}
+
+
+SECONDARY_SURFACE_LAWS = {"f16": f16_secondary_surfaces}

@@ -20,6 +20,7 @@ from models.hidden import hidden_root, needs_copy
 from models.trim import TrimError, TrimPoint, trim
 from models.truth import CoefficientProbe, central_differences, differencing_instance
 from models.constants import BODY_COEFFICIENTS, SURFACES
+from models.configuration import SECONDARY_SURFACE_LAWS
 
 START_WINDOW_S = 0.5  # the recording's start: the span its initial condition and surface levels average
 
@@ -187,6 +188,10 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     coefficient 0.005 where its flight, at 1,883 rpm, had 0.052; C_m 0.008 apart), settled at
     1,894 rpm and 0.055; a spiral dive from 230 to 367 ft/s then put a C_m mismatch of 0.025
     into a noise-free flight of the model itself, read as C_m,ΔV (t 12-19).
+
+    With ``aircraft.secondary_surfaces == "fcs"`` the surfaces its FCS moves beside δe, δa, δr
+    (:data:`models.configuration.SECONDARY_SURFACE_LAWS`: the F-16's leading-edge flap and
+    flaperons) are set at each state by the FCS's laws (a second ``run_ic``), not held at trim.
     """
     cond, kwargs = _instance(aircraft, ic, refs)
     trim_failed = ""
@@ -213,6 +218,7 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
     out = {c: np.empty(n) for c in BODY_COEFFICIENTS}
     propulsion = {c: np.empty(n) for c in ("Cl", "Cm", "Cn")}
     engines = fdm.get_propulsion() if has_propeller(aircraft.model) else None
+    law = SECONDARY_SURFACE_LAWS.get(aircraft.name) if aircraft.secondary_surfaces == "fcs" else None
     fdm["ic/lat-gc-deg"] = 0.0
     fdm["ic/long-gc-deg"] = 0.0
     for k in range(n):
@@ -228,6 +234,11 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
         for s in SURFACES:
             setters[surf[s]](float(sv[s][k]))
         fdm.run_ic()
+        if law is not None:  # the FCS's other surfaces at this state, then the forces again
+            for prop, v in law(float(cols["alpha"][k]), fdm["velocities/mach"], fdm["velocities/vc-kts"],
+                               float(sv["da"][k])).items():
+                fdm[prop] = v
+            fdm.run_ic()
         if engines is not None:  # the propeller settled at this state (docstring), then the forces again
             engines.get_steady_state()
             fdm.run_ic()

@@ -23,6 +23,10 @@ SURFACE_PROPERTIES = {"f16": ("fcs/elevator-pos-rad", "fcs/aileron-pos-rad", "fc
                       "c172x": ("fcs/elevator-pos-rad", "fcs/effective-aileron-pos", "fcs/rudder-pos-rad")}
 
 
+# The pilot's commands an aircraft's FCS reads (JSBSim's convention), for flights with it on.
+STICK_COMMANDS = {"de": "fcs/elevator-cmd-norm", "da": "fcs/aileron-cmd-norm", "dr": "fcs/rudder-cmd-norm"}
+
+
 def inputs(kind: str, amplitude_rad: float, duration_s: float, rng: np.random.Generator) -> dict[str, np.ndarray]:
     """Surface commands (rad from trim) at 100 Hz: ``ms3``, ``ms_pitch``, ``ms_lat`` multisines
     from 1 to 21 s, or ``dbl3`` doublets at 1, 8 and 15 s."""
@@ -67,18 +71,23 @@ def trimmed(model: str, h_ft: float, V_fps: float, sim_hz: float = 100.0, xml_pl
 
 def fly(path: Path, model: str, h_ft: float, V_fps: float, seed: int, out_hz: float, kind: str,
         units: str = "si", noise: float = 1.0, duration_s: float = 28.0, amplitude_deg: float = 2.0,
-        xml_placement: bool = True, root: str | None = None) -> Path:
+        xml_placement: bool = True, root: str | None = None, stick: bool = False) -> Path:
     """Fly ``model`` and write ``path`` (CSV) beside its ``.meta.json``; the 737's aerodynamic
     reference point stays where its XML puts it unless ``xml_placement`` is False (then it is
     moved onto the c.g., as shared/jsbsim-notes.md suggests for exact truth); ``root`` is a
-    JSBSim root folder holding a modified copy of the aircraft (default: the package's)."""
+    JSBSim root folder holding a modified copy of the aircraft (default: the package's).
+    ``stick``: fly with the aircraft's FCS on, the inputs (``amplitude_deg`` read as hundredths
+    of full stick) written to its pilot commands and the surfaces it moves recorded, as a
+    flight-test aircraft flies."""
     sim_hz = 200.0 if 100.0 % out_hz else 100.0
     fdm = trimmed(model, h_ft, V_fps, sim_hz, xml_placement, root)
-    fdm["simulation/models/FGFCS/enabled"] = 0
-    props = dict(zip(("de", "da", "dr"), SURFACE_PROPERTIES[model]))
+    if not stick:
+        fdm["simulation/models/FGFCS/enabled"] = 0
+    recorded = dict(zip(("de", "da", "dr"), SURFACE_PROPERTIES[model]))
+    props = STICK_COMMANDS if stick else recorded
     trim = {s: fdm[p] for s, p in props.items()}
     rng = np.random.default_rng(seed)
-    command = inputs(kind, math.radians(amplitude_deg), duration_s + 1.0, rng)
+    command = inputs(kind, amplitude_deg / 100.0 if stick else math.radians(amplitude_deg), duration_s + 1.0, rng)
     state = {s: [0.0, 0.0] for s in props}
     h = 1.0 / sim_hz / 4
     mass, n_sub = fdm["inertia/mass-slugs"], int(round(sim_hz / out_hz))
@@ -98,7 +107,7 @@ def fly(path: Path, model: str, h_ft: float, V_fps: float, seed: int, out_hz: fl
                      *(fdm[f"velocities/{a}i-rad_sec"] for a in "pqr"),
                      fdm["attitude/phi-rad"], fdm["attitude/theta-rad"], fdm["attitude/psi-rad"],
                      *(fdm[f"forces/fb{a}-total-lbs"] / (mass * G0) for a in "xyz"),
-                     *(fdm[props[s]] for s in ("de", "da", "dr")), fdm["aero/qbar-psf"], fdm["position/h-sl-ft"]])
+                     *(fdm[recorded[s]] for s in ("de", "da", "dr")), fdm["aero/qbar-psf"], fdm["position/h-sl-ft"]])
     X = np.array(rows)
     deg = math.radians(1.0)
     sigma = np.array([0, 0.5, 0.1 * deg, 0.1 * deg] + [0.1 * deg] * 3 + [0.2 * deg] * 3 + [0.01] * 3

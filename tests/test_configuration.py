@@ -196,3 +196,19 @@ def test_a_package_aircraft_jsbsim_cannot_initialise_is_refused_by_name(name, ne
     with pytest.raises(AircraftError, match="JSBSim cannot initialise") as err:
         trim(load_fdm(aircraft, 1 / 120), aircraft, parse_condition("h=10000,V=350"))
     assert needle in str(err.value) and path in str(err.value)
+
+
+def test_the_f16_fcs_laws_for_its_leading_edge_flap_and_flaperons():
+    """models.configuration.f16_secondary_surfaces, pinned to f16.xml's switch and mixer: the
+    flap at 0.262 rad above α = 0.0873, 0.436 above 0.2618, −0.0349 above Mach 0.9 below them;
+    the flaperons' mix 1.4324 (clip(−tef − a) + clip(tef − a)), a = δa/0.375 · (1 − 0.85 M)."""
+    from models.configuration import f16_secondary_surfaces as law
+    assert law(0.05, 0.4, 300.0, 0.0) == {"fcs/lef-pos-rad": 0.0, "fcs/flaperon-mix-rad": 0.0}
+    assert law(0.1, 0.4, 300.0, 0.0)["fcs/lef-pos-rad"] == 0.262
+    assert law(0.3, 0.4, 300.0, 0.0)["fcs/lef-pos-rad"] == 0.436
+    assert law(0.05, 0.95, 300.0, 0.0)["fcs/lef-pos-rad"] == -0.0349
+    # half aileron at Mach 0, flaps up: a = 0.5, mix = 1.4324 (-0.5 - 0.5)
+    assert law(0.0, 0.0, 300.0, 0.1875)["fcs/flaperon-mix-rad"] == pytest.approx(-1.4324)
+    # the same below 250 kt: the trailing-edge flap (0.99981 normalised) clips one flaperon
+    tef = 2.864789 * 0.349
+    assert law(0.0, 0.0, 200.0, 0.1875)["fcs/flaperon-mix-rad"] == pytest.approx(1.4324 * (-1.0 + tef - 0.5))

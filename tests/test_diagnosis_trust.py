@@ -80,8 +80,9 @@ def test_assumptions_name_the_stand_ins_for_missing_channels(tmp_path):
     assert "surface_levels_deg" in by_item["surface levels (replays)"]["stood_in_by"]
     assert "through the c.g." in by_item["thrust line"]["stood_in_by"]  # the F-16's is 0.3 ft above it
     assert "Eq. 40" in by_item["standard errors"]["stood_in_by"]
-    # the F-16's leading-edge flap and flaperons stay where trim put them (its FCS disabled)
-    assert "fcs/lef-pos-rad" in by_item["other control surfaces"]["stood_in_by"]
+    # the F-16's leading-edge flap and flaperons stay where trim put them: it was flown with its FCS off
+    assert by_item["other control surfaces"]["choice"] == "held"
+    assert "held where the model's trim put them" in by_item["other control surfaces"]["stood_in_by"]
     assert _effects(result) == ["none"]  # a clean recording of the model, made elsewhere in the envelope
     written = json.loads((tmp_path / "out" / "findings.json").read_text())
     assert written["assumptions"] and written["not_checked"]

@@ -329,3 +329,21 @@ def test_an_alpha_scale_the_kinematics_cannot_see_is_not_named_a_lift_slope(tmp_
     assert {p for p, _ in _found(result)} <= {"scale_alpha"}
     apart = next(f for f in result["not_confirmed"] if f["parameter"] == "CZ_alpha")
     assert "of the opposite sign" in apart["evidence"]["validation"]["reason"]
+
+
+def test_an_f16_flown_with_its_fcs_on_is_evaluated_with_the_fcs_s_surfaces(tmp_path):
+    """harness/diagnosis/fcs_surfaces.py: an F-16 three-axis multisine flown through its own
+    FCS (stick commands; the leading-edge flap switching at α = 5° as α crosses it at 427.4
+    ft/s, the flaperons following the aileron) is evaluated with those surfaces moved by the
+    FCS's laws — its held mismatch shrinks more than tenfold — and gives `none` (it named six
+    terms, C_Z,α̇ 383 among them, with them held); the same flight with the FCS off keeps them
+    held."""
+    on = fly(tmp_path / "on.csv", "f16", 10_000.0, 427.4, 537, 50.0, "ms3", noise=1.0, amplitude_deg=15.0,
+             stick=True)
+    res = diagnose("f16", on, tmp_path / "d_on", None, calibrate=False)
+    note = next(a for a in res["assumptions"] if a["item"] == "other control surfaces")
+    assert note["choice"] == "fcs" and note["shares"]["fcs"] < 0.1 * note["shares"]["held"]
+    assert [f["effect"] for f in res["findings"]] == ["none"]
+    off = fly(tmp_path / "off.csv", "f16", 10_000.0, 427.4, 537, 50.0, "ms3", noise=1.0, amplitude_deg=2.0)
+    res = diagnose("f16", off, tmp_path / "d_off", None, calibrate=False)
+    assert next(a for a in res["assumptions"] if a["item"] == "other control surfaces")["choice"] == "held"

@@ -17,6 +17,7 @@ from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_
                                          sensor_models, terms_of, unsupported_in_the_loop, with_calibration,
                                          recording_start_references, write_model)
 from harness.diagnosis.evidence import Analysis, Candidate
+from harness.diagnosis.fcs_surfaces import choose_secondary_surfaces
 from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.mode_model import attach_mode_models
 from harness.diagnosis.prepare import instruments_at_cg, prepare
@@ -232,6 +233,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     reference = choose_reference_point(p, aircraft, ic, aero_reference)
     if reference is not None:
         aircraft = reference.aircraft
+    aircraft, surfaces_note = choose_secondary_surfaces(p, aircraft, ic)
     if validation is not None and pool is not None and choosing:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     a = analyse(p, aircraft, ic)
@@ -277,7 +279,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         "located": located,
         "not_confirmed": [finding_dict(f, {}, {}, checks.get(id(f))) for f in unconfirmed],
         "calibration": calibration,
-        "assumptions": (assumptions(a, aircraft, mass) + ([reference.assumption()] if reference else [])
+        "assumptions": (assumptions(a, aircraft, mass, surfaces_note) + ([reference.assumption()] if reference else [])
                         + calibration_assumptions(calibration)),
         "not_checked": not_checked(a, validation is not None),
         "detection_limits": detection_limits(a),

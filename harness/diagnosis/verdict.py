@@ -435,7 +435,7 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
     return out
 
 
-def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
+def assumptions(a: Analysis, aircraft: Aircraft, mass: str, surfaces_note: dict | None = None) -> list[dict]:
     """What the diagnosis assumed: the recording's stand-ins (:attr:`Prepared.assumptions`),
     with the thrust value used, and the mass the model flew with."""
     out = [dict(x) for x in a.prepared.assumptions]
@@ -455,7 +455,7 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str) -> list[dict]:
                 "stood_in_by": ("each surface moves by its recorded change from a start level fitted, per replay, "
                                 "within the noise of its first 0.5 s (fit_before/fit_after: surface_levels_deg; "
                                 "harness/diagnosis/levels.py)")})
-    held = held_surfaces_assumption(aircraft, a.aero.trim)
+    held = surfaces_note or held_surfaces_assumption(aircraft, a.aero.trim)
     if held:
         out.append(held)
     out.append(STANDARD_ERRORS_ASSUMPTION)
