@@ -31,6 +31,7 @@ from harness.executors import LocalPool
 from harness.recording_io import read_recording
 from models.aircraft import (AERO_REFERENCES, MODEL_ARGUMENT_HELP, MODELS, Aircraft, is_xml_model, model_argument,
                              nominal_root, reference_point_alternative)
+from models.configuration import SECONDARY_SURFACE_LAWS
 from models.mass import MassProperties, mass_root
 from models.replay import initial_condition
 
@@ -223,8 +224,10 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     aircraft, recs = _loaded(model, recording, validation, mass, aero_reference)
     pending = None
     # the validation maneuver is analysed in a second process meanwhile, with the aircraft
-    # placed as the identification says where it can be placed two ways
-    choosing = aero_reference == "auto" and reference_point_alternative(aircraft) is not None
+    # placed as the identification says where it can be placed two ways, and its FCS's other
+    # surfaces as the identification says where it has such (fcs_surfaces.py)
+    choosing = ((aero_reference == "auto" and reference_point_alternative(aircraft) is not None)
+                or aircraft.name in SECONDARY_SURFACE_LAWS)
     if validation is not None and pool is not None and not choosing:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     p = prepare(recs["identification"], "identification")
