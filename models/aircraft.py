@@ -239,6 +239,15 @@ def missing_files(model: str) -> list[str]:
     return missing
 
 
+def aerodynamics_reads(model: str) -> set[str]:
+    """The properties an aircraft XML's ``<aerodynamics>`` reads (``<property>`` and
+    ``<independentVar>`` elements)."""
+    aero = ET.parse(model_xml(model)).getroot().find("aerodynamics")
+    if aero is None:
+        return set()
+    return {(el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar")}
+
+
 def xml_surface_properties(model: str) -> dict[str, str]:
     """The surface properties an aircraft XML's aerodynamics read (``SURFACE_CANDIDATES``).
 
@@ -247,9 +256,7 @@ def xml_surface_properties(model: str) -> dict[str, str]:
     ValueError
         Naming the surface none of whose candidate properties the aerodynamics read.
     """
-    aero = ET.parse(model_xml(model)).getroot().find("aerodynamics")
-    read = {(el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar")} \
-        if aero is not None else set()
+    read = aerodynamics_reads(model)
     out = {}
     for s, props in SURFACE_CANDIDATES.items():
         found = [p for p in props if p in read]
@@ -266,11 +273,8 @@ def other_fcs_properties(model: str, surfaces: dict[str, str]) -> tuple[str, ...
     speed brakes, the F-16's leading-edge flap and flaperons. The project flies and evaluates the
     model with its FCS disabled, so these stay where trim put them; a recording flown with the
     FCS on may have moved them."""
-    aero = ET.parse(model_xml(model)).getroot().find("aerodynamics")
-    read = sorted({(el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar")}
-                  if aero is not None else set())
     primary = set(surfaces.values())
-    return tuple(p for p in read if p.startswith("fcs/") and p not in primary
+    return tuple(p for p in sorted(aerodynamics_reads(model)) if p.startswith("fcs/") and p not in primary
                  and not (p.startswith("fcs/mag-") and p.replace("fcs/mag-", "fcs/") in primary))
 
 

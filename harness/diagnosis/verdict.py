@@ -471,7 +471,7 @@ def held_surfaces_assumption(aircraft: Aircraft, trim) -> dict | None:
     props = other_fcs_properties(aircraft.model, aircraft.surfaces)
     if not props:
         return None
-    positions = (getattr(trim, "configuration", None) or {}).get("positions", {})
+    positions = trim.configuration.get("positions", {})
     values = ", ".join(f"{p} {positions[p]:.3g}" if p in positions else p for p in props)
     return {"item": "other control surfaces", "missing": "their positions (not recording-format channels)",
             "stood_in_by": (f"held where the model's trim put them, its FCS disabled: {values}; a recording flown "
