@@ -261,8 +261,12 @@ def xml_surface_properties(model: str) -> dict[str, str]:
     for s, props in SURFACE_CANDIDATES.items():
         found = [p for p in props if p in read]
         if not found:
-            raise AircraftError(f"{model}: its aerodynamics read none of {props}, so the {s} input has "
-                             "nowhere to go (the project drives these surface properties directly)")
+            word = props[0].split("/")[1].split("-")[0]  # 'elevator', 'aileron', 'rudder'
+            other = sorted(p for p in read if p.startswith("fcs/") and word in p and "mag-" not in p)
+            instead = (f" (they read {', '.join(other)} instead: a position in other units, which the XML "
+                       "does not relate to the recording's radians)" if other else "")
+            raise AircraftError(f"{model}: its aerodynamics read none of {props}{instead}, so the {s} input "
+                                "has nowhere to go (the project drives these surface properties directly)")
         out[s] = found[0]
     return out
 

@@ -212,3 +212,12 @@ def test_the_f16_fcs_laws_for_its_leading_edge_flap_and_flaperons():
     # the same below 250 kt: the trailing-edge flap (0.99981 normalised) clips one flaperon
     tef = 2.864789 * 0.349
     assert law(0.0, 0.0, 200.0, 0.1875)["fcs/flaperon-mix-rad"] == pytest.approx(1.4324 * (-1.0 + tef - 0.5))
+
+
+def test_an_aircraft_whose_aerodynamics_read_normalised_surfaces_is_refused_by_name():
+    """The package's T-38 reads fcs/elevator-pos-norm (its XML gives no radian scale): a
+    recording's de_rad has nowhere to go, and the message says what the aerodynamics read."""
+    from models.aircraft import AircraftError, library_xml, xml_surface_properties
+    with pytest.raises(AircraftError, match=r"read fcs/elevator-pos-norm instead.*de input"):
+        xml_surface_properties(str(library_xml("T38")))
+    assert xml_surface_properties(str(library_xml("c172p")))["de"] == "fcs/elevator-pos-rad"
