@@ -48,8 +48,11 @@ def inputs(kind: str, amplitude_rad: float, duration_s: float, rng: np.random.Ge
 
 def trimmed(model: str, h_ft: float, V_fps: float, sim_hz: float = 100.0, xml_placement: bool = True,
             root: str | None = None):
-    """``model`` trimmed by JSBSim in level flight at ``h_ft`` and ``V_fps``, gear up (see :func:`fly`)."""
+    """``model`` trimmed by JSBSim in level flight at ``h_ft`` and ``V_fps``, gear up (see :func:`fly`):
+    a retractable gear is put up at once; a fixed gear stays where it is, its drag included."""
     import jsbsim
+    xml = Path(root or jsbsim.get_default_root_dir()) / "aircraft" / model / f"{model}.xml"
+    retractable = "<retractable>1</retractable>" in xml.read_text().replace(" ", "")
     fdm = jsbsim.FGFDMExec(root)
     fdm.set_debug_level(0)
     assert fdm.load_model(model)
@@ -63,7 +66,8 @@ def trimmed(model: str, h_ft: float, V_fps: float, sim_hz: float = 100.0, xml_pl
             fdm[f"metrics/aero-rp-{ax}-in"] = fdm[f"inertia/cg-{ax}-in"]
         fdm.run_ic()
     fdm["propulsion/set-running"] = -1
-    fdm["gear/gear-pos-norm"] = 0.0
+    if retractable:
+        fdm["gear/gear-pos-norm"] = 0.0
     fdm["fcs/throttle-cmd-norm"] = 0.7
     fdm.do_trim(1)
     return fdm
