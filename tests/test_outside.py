@@ -631,6 +631,22 @@ def test_a_time_column_the_gyros_disagree_with_is_refused(tmp_path, factor):
     assert r.returncode == 2 and "time column cannot be right" in r.stderr and "Traceback" not in r.stderr
 
 
+def test_a_record_in_which_nothing_moved_is_not_refused_for_its_time_column(tmp_path):
+    """The F-16 flown without inputs (the script's noise only): its bank and pitch angles
+    move no more than their noise, so the attitudes-over-gyros ratio is not taken
+    (kinematics.time_base_ratio is None; it read 0.08 ± 0.15 and the record was refused as
+    stamped 13 times too slow), and the diagnosis finds nothing."""
+    from harness.diagnosis.kinematics import time_base_ratio
+    from harness.diagnosis.prepare import instruments_at_cg, prepare
+    from harness.diagnosis.run import diagnose
+    from harness.recording_io import read_recording
+    from independent_script import fly
+    path = fly(tmp_path / "still.csv", "f16", 10000.0, 427.4, 631, 50, "ms3", amplitude_deg=0.0)
+    assert time_base_ratio(prepare(instruments_at_cg(read_recording(path)))) is None
+    result = diagnose("f16", path, tmp_path / "out", calibrate=False)
+    assert [f["effect"] for f in result["findings"]] == ["none"]
+
+
 def test_a_recording_too_short_to_diagnose_is_a_user_error(tmp_path):
     """A 6 s record stamped 50 times too fast (0.12 s) is refused with exit status 2 naming
     its length (harness.diagnosis.prepare raises a UserError); it was reported as an internal
