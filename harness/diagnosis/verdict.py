@@ -8,7 +8,7 @@ import numpy as np
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import interior
 from harness.diagnosis.evidence import Analysis, Candidate
-from harness.diagnosis.gust_rules import vane_wander
+from harness.diagnosis.gust_rules import NOT_IN_GUSTS, NOT_IN_TURBULENCE, vane_wander
 from harness.diagnosis.kinematics import time_base_problem
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
@@ -424,6 +424,7 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
     if a.gusty:
         out += [{"effect": e, "parameters": [], "reason": a.gusty}
                 for e in ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")]
+    out += in_turbulence(a)
     if vane_wander(a.air, a.gusty):
         out.append({"effect": "coefficient_error", "parameters": ["terms in alpha, its powers and alphadot"],
                     "reason": a.gusty})
@@ -433,6 +434,34 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
         out.append({"effect": "(every finding)", "parameters": [],
                     "reason": "no validation maneuver was given: no finding was tested on a second maneuver"})
     return out
+
+
+SENSOR_EFFECTS = ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")
+IN_TURBULENCE = ("in turbulence the kinematic consistency (air-relative against inertial velocity) does not hold, "
+                 "so no sensor error is named from it")
+
+
+def in_turbulence(a: Analysis) -> list[dict]:
+    """What turbulence left untested, when it is named (not light gusts, which ``a.gusty``
+    covers): every sensor effect (the kinematic consistency does not hold) and every term fitted
+    to the coefficient mismatch (the gust's rotational part is an unmeasured regressor), each
+    listing the parameters that passed every other rule and were withheld for it, so that an
+    error under the gusts is not silently dropped (probe 59: a q-gyro bias of 0.5 deg/s under
+    Dryden severity 3 estimated at 0.0089 ± 0.0004 rad/s, t 25, beside the turbulence named)."""
+    named = any(c.effect == "turbulence" and c.selected for c in a.candidates)
+    if not named or a.gusty:
+        return []
+    terms = sorted({c.effect for c in a.candidates if c.reason == NOT_IN_GUSTS} | {"coefficient_error"})
+    return ([_withheld(a.candidates, e, NOT_IN_TURBULENCE, IN_TURBULENCE, "those listed passed every other rule")
+             for e in SENSOR_EFFECTS]
+            + [_withheld(a.candidates, e, NOT_IN_GUSTS, "terms fitted to the coefficient mismatch are " + NOT_IN_GUSTS,
+                         "those listed entered and were withheld") for e in terms])
+
+
+def _withheld(cands: list[Candidate], effect: str, reason: str, because: str, listed: str) -> dict:
+    """A ``not_checked`` entry: ``effect``'s candidates withheld for ``reason``, and why."""
+    names = sorted(c.parameter for c in cands if c.effect == effect and c.reason == reason)
+    return {"effect": effect, "parameters": names, "reason": because + (f"; {listed} (see candidates)" if names else "")}
 
 
 def assumptions(a: Analysis, aircraft: Aircraft, mass: str, surfaces_note: dict | None = None) -> list[dict]:
