@@ -945,6 +945,29 @@ def test_a_rival_overturns_a_finding_by_the_validation_records_sampling_error(ow
     assert rival_fits_as_well(own, theirs, 0.30, indistinct, change) is expected
 
 
+def test_a_rival_comparison_is_made_without_the_vanes_noise():
+    """validation._less_nuisances: a residual on C_m less its fit on the maneuver's nuisance
+    columns and, where the stepwise's gate left it out, the α vane's error (the kinematic
+    residual's vertical "gust"); other axes keep their own nuisances only. A finding built on
+    α would otherwise win against a rival on another channel by removing the vane's noise the
+    model's slopes pass into the mismatch (probe 61)."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.validation import _less_nuisances
+    t = np.linspace(0.0, 20.0, 1001)
+    w = np.sin(2.3 * t) + 0.3 * np.cos(0.7 * t)
+    effect = np.sin(0.4 * t) ** 3
+    av = SimpleNamespace(nuisances={"Cm": {}, "CZ": {}}, gust=SimpleNamespace(w_fps=w))
+    inner = slice(50, -50)
+    left = _less_nuisances(av, "Cm", (0.02 * w + effect + 0.1)[inner], inner)
+    fitted = np.column_stack([w[inner], np.ones(left.size)])
+    expected = effect[inner] - fitted @ np.linalg.lstsq(fitted, effect[inner], rcond=None)[0]
+    assert np.allclose(left, expected, atol=1e-12)
+    assert np.array_equal(_less_nuisances(av, "CZ", effect[inner], inner), effect[inner])
+    gated = SimpleNamespace(nuisances={"Cm": {"vane_alpha_noise": 3.0 * w}}, gust=SimpleNamespace(w_fps=w))
+    assert np.allclose(_less_nuisances(gated, "Cm", (0.02 * w + effect + 0.1)[inner], inner), expected, atol=1e-12)
+
+
 def test_the_ambiguous_reason_says_which_rule_left_the_finding_undecided():
     from harness.diagnosis.validation import _ambiguous_reason
     rival = {"parameter": "Cm_de", "correlation": -0.93, "noise_levels_own": 1.60, "noise_levels_rival": 1.59,

@@ -239,16 +239,35 @@ def _rival_check(av: Analysis, f: Candidate, axes: list[str], after: dict[str, n
     rival_after, _ = after_mismatch(av, [twin])
     inner = interior(av.prepared)
     rival_rms = {c: _rms(rival_after[c][inner]) for c in axes}
-    # summed over the axes in units of each axis's noise level, as validation_check does
+    # summed over the axes in units of each axis's noise level, as validation_check does, each
+    # residual less the validation maneuver's own nuisance columns
     w = _noise_weights(av, axes)
-    own = sum(w[c] * _rms(after[c]) for c in axes)
-    theirs = sum(w[c] * rival_rms[c] for c in axes)
+    own = sum(w[c] * _rms(_less_nuisances(av, c, after[c], inner)) for c in axes)
+    theirs = sum(w[c] * _rms(_less_nuisances(av, c, rival_after[c][inner], inner)) for c in axes)
     margin = max(rms_margin(after[c]) for c in axes)
     indistinct = r.get("indistinct", "")
     return {"parameter": r["parameter"], "correlation": r["correlation"], "rms_after": rival_rms, "margin": margin,
             "noise_levels_own": own, "noise_levels_rival": theirs,
             "fits_as_well": rival_fits_as_well(own, theirs, margin, bool(indistinct), change),
             "indistinct": indistinct}
+
+
+def _less_nuisances(av: Analysis, axis: str, residual: np.ndarray, inner: slice) -> np.ndarray:
+    """``residual`` (on ``inner``) less its least-squares fit on the maneuver's nuisance
+    columns of ``axis`` (the α vane's noise column in C_m, :func:`stepwise_axes.vane_noise_columns`),
+    as the stepwise fits them: a finding built on α carries the vane's noise as the model's
+    slopes pass it into the mismatch, and would otherwise win a comparison with a rival built
+    on another channel by removing that noise rather than the effect (probe 61: a 737 with 60 %
+    less fuel, its c.g. 1.26 ft aft of the model's, read as C_m,α because the moment-reference
+    shift's column, the measured C_Z, does not carry the vane's noise)."""
+    cols = [col[inner] for col in (av.nuisances or {}).get(axis, {}).values() if np.ptp(col[inner]) > 0]
+    w = getattr(av.gust, "w_fps", None)
+    if axis == "Cm" and w is not None and "vane_alpha_noise" not in (av.nuisances or {}).get(axis, {}):
+        cols.append(np.asarray(w, dtype=float)[inner])  # the vane's error, ungated here
+    if not cols:
+        return residual
+    A = np.column_stack(cols + [np.ones(residual.size)])
+    return residual - A @ np.linalg.lstsq(A, residual, rcond=None)[0]
 
 
 def _noise_weights(av: Analysis, axes: list[str]) -> dict[str, float]:
