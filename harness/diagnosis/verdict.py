@@ -422,8 +422,7 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
         grouped.setdefault((effect, why), []).append(name)
     out = [{"effect": e, "parameters": sorted(dict.fromkeys(ps)), "reason": why} for (e, why), ps in grouped.items()]
     if a.gusty:
-        out += [{"effect": e, "parameters": [], "reason": a.gusty}
-                for e in ("sensor_bias", "sensor_scale", "sensor_time_skew", "sensor_offset")]
+        out += [{"effect": e, "parameters": [], "reason": a.gusty} for e in SENSOR_EFFECTS]
     out += in_turbulence(a)
     if vane_wander(a.air, a.gusty):
         out.append({"effect": "coefficient_error", "parameters": ["terms in alpha, its powers and alphadot"],
