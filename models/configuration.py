@@ -120,13 +120,17 @@ def configuration_record(fdm: jsbsim.FGFDMExec, config: Configuration, written: 
     }
 
 
+# The F-16's leading-edge flap (JSBSim's f16.xml, <switch name="fcs/lef-pos-rad">), airborne and
+# gear up: (position, the alpha above which it is set), rad, the higher first; -0.0349 rad above
+# Mach 0.9 below both; else 0.
+F16_LEF_BY_ALPHA = ((0.436, 0.2618), (0.262, 0.0873))
+F16_LEF_SUPERSONIC = (-0.0349, 0.9)  # (position rad, Mach above which)
+
 # Surfaces an aircraft's FCS schedules discontinuously (switches with no hysteresis): their
 # possible positions, in order of preference when no position is consistent with the schedule
-# at the equilibrium it gives (see models.trim.trim). The F-16's leading-edge flap (JSBSim's
-# f16.xml, <switch name="fcs/lef-pos-rad">): 0.262 rad airborne with alpha > 0.0873 rad,
-# 0.436 rad gear up with alpha > 0.2618 rad, -0.0349 rad above Mach 0.9, else 0.
+# at the equilibrium it gives (see models.trim.trim): the F-16's leading-edge flap.
 SCHEDULED_SURFACES: dict[str, dict[str, tuple[float, ...]]] = {
-    "f16": {"fcs/lef-pos-rad": (0.262, 0.0, 0.436, -0.0349)},
+    "f16": {"fcs/lef-pos-rad": (F16_LEF_BY_ALPHA[1][0], 0.0, F16_LEF_BY_ALPHA[0][0], F16_LEF_SUPERSONIC[0])},
 }
 
 
@@ -134,8 +138,7 @@ SCHEDULED_SURFACES: dict[str, dict[str, tuple[float, ...]]] = {
 # the three the recording carries (recording-format: de, da, dr): the laws by which JSBSim's
 # f16.xml moves them, for evaluating a recording flown with the FCS on (the project flies and
 # evaluates the model with its FCS disabled, where they stay at trim). From f16.xml: the
-# leading-edge flap is the switch <fcs/lef-pos-rad> (airborne, gear up: 0.436 rad above α =
-# 0.2618 rad, 0.262 above 0.0873, −0.0349 above Mach 0.9, else 0); the flaperons' mix
+# leading-edge flap is the switch above (F16_LEF_BY_ALPHA, F16_LEF_SUPERSONIC); the flaperons' mix
 # <fcs/flaperon-mix-rad> = 1.4324 (clip(−tef − a) + clip(tef − a)), clip to ±1, with the aileron's
 # speed-compensated command a = (δa / 0.375)(1 − 0.85 M) (the scheduled gain 1 → 0.15 over Mach
 # 0 → 1) and the trailing-edge flap's normalised position tef = 2.864789 × (0.349 rad below 250
@@ -143,7 +146,8 @@ SCHEDULED_SURFACES: dict[str, dict[str, tuple[float, ...]]] = {
 # the flaps' 3 s full travel) are left out.
 def f16_secondary_surfaces(alpha_rad: float, mach: float, vc_kts: float, da_rad: float) -> dict[str, float]:
     """The F-16's leading-edge flap and flaperon mix (rad) as its FCS sets them at a state."""
-    lef = 0.436 if alpha_rad > 0.2618 else 0.262 if alpha_rad > 0.0873 else -0.0349 if mach > 0.9 else 0.0
+    lef = next((pos for pos, above in F16_LEF_BY_ALPHA if alpha_rad > above),
+               F16_LEF_SUPERSONIC[0] if mach > F16_LEF_SUPERSONIC[1] else 0.0)
     gain = 1.0 - 0.85 * min(max(mach, 0.0), 1.0)
     a = min(max(da_rad / 0.375, -1.0), 1.0) * gain
     tef = 2.864789 * (0.349 if vc_kts < 250.0 else -0.0349 if mach > 0.9 else 0.0)

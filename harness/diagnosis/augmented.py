@@ -350,8 +350,9 @@ def unsupported_in_the_loop(findings: list[Candidate], calibration: dict, checks
             continue
         ee = f.details.get("change", f.estimate)
         weak = abs(own["size"]) < CALIBRATED_MIN_Z * own["std_error"]
+        unflown = weak or own["size"] * ee < 0  # a mismatch the augmented model does not fly
         why = (f"within {CALIBRATED_MIN_Z:g} standard errors of no change" if weak else
-               "of the opposite sign" if own["size"] * ee < 0 else _too_small_calibrated(f, own["size"], ee))
+               "of the opposite sign" if unflown else _too_small_calibrated(f, own["size"], ee))
         if not why:
             continue
         before = checks.get(id(f)) or {}
@@ -360,7 +361,7 @@ def unsupported_in_the_loop(findings: list[Candidate], calibration: dict, checks
                                     f"{own['size']:.3g} ± {own['std_error']:.2g}, {why} (equation error: {ee:.3g}"
                                     f" ± {f.std_error:.2g}): " + (
                                         "the mismatch it fitted is not one the augmented model flies"
-                                        if weak or own["size"] * ee < 0 else
+                                        if unflown else
                                         "at the size the augmented model flies it fails a rule it entered by"))}
         out.append(f)
     return out
