@@ -147,7 +147,9 @@ def scope_section(data: Mapping) -> Section | None:
     tables = []
     if assumed:
         tables.append(Table("Assumptions", pd.DataFrame(
-            [{"what": a.get("item", ""), "missing": a.get("missing", ""), "assumed instead": a.get("stood_in_by", "")}
+            [{"what": a.get("item", ""), "missing": a.get("missing", ""),
+              "assumed instead": a.get("stood_in_by", "") + (f" (but {a['contradicted_by']})"
+                                                             if a.get("contradicted_by") else "")}
              for a in assumed]), "Where the recording is silent, what stood in. A finding may depend on these."))
     if unchecked:
         tables.append(Table("Not checked", pd.DataFrame(

@@ -1558,3 +1558,56 @@ def test_a_recording_through_the_vertical_is_refused_for_that_reason():
     over = SimpleNamespace(name="identification", t=t, raw={"theta": np.radians(89.7 * np.sin(t / 2))})
     with pytest.raises(DiagnosisError, match=r"theta = 89\.7 deg \(at t = 3\.14 s\), within 5 deg of the vertical"):
         check_attitude_range(over)
+
+
+def _throttle_recording(throttle, thrust: bool = False):
+    import pandas as pd
+    from maneuvers.recording import Recording
+    n = len(throttle)
+    data = pd.DataFrame({"t_s": np.arange(n) * 0.02, "throttle_1": np.asarray(throttle, dtype=float)})
+    if thrust:
+        data["thrust_lbf"] = 2000.0
+    return Recording(data=data, meta={}, name="r")
+
+
+def test_a_moved_throttle_without_thrust_contradicts_the_constant_thrust_stand_in():
+    """throttle_travel gives the throttle's 1st-99th percentile range when it moved more than
+    THROTTLE_STEADY with no thrust channel; a held throttle (or thrust recorded) gives None,
+    and one spike does not count as travel."""
+    from harness.diagnosis.prepare import THROTTLE_STEADY, _stand_ins, throttle_travel
+    moved = np.r_[np.full(200, 0.3), np.full(200, 0.6), np.full(200, 0.3)]
+    assert throttle_travel(_throttle_recording(moved)) == pytest.approx((0.3, 0.6))
+    assert throttle_travel(_throttle_recording(moved, thrust=True)) is None
+    held = np.full(600, 0.7) + np.random.default_rng(1).normal(scale=0.002, size=600)
+    held[300] = 1.0
+    assert throttle_travel(_throttle_recording(held)) is None
+    assert throttle_travel(_throttle_recording(np.linspace(0.5, 0.5 + 0.9 * THROTTLE_STEADY, 600))) is None
+    entry = _stand_ins({}, {}, ("t_s", "throttle_1"), (0.3, 0.6))[0]
+    assert entry["item"] == "thrust" and "moved from 0.30 to 0.60" in entry["contradicted_by"]
+    assert "contradicted_by" not in _stand_ins({}, {}, ("t_s",))[0]
+
+
+@pytest.mark.parametrize("propeller", [False, True])
+def test_terms_a_thrust_change_imitates_are_withheld_when_the_throttle_moved_unrecorded(propeller):
+    """With the throttle moving and no thrust channel, candidates on C_X and C_m (terms, a
+    moment-reference shift, the stabilator's delay) are withheld, and behind a propeller C_l
+    and C_n's too; C_Z's and sensor candidates stay; a held throttle withholds nothing."""
+    from types import SimpleNamespace
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.stepwise_axes import NOT_WITH_THROTTLE, withhold_on_moving_throttle
+
+    def cands():
+        return [Candidate("coefficient_error", "lon", ch, f"{ch}_x", 0.1, 0.01, 10.0, 0.5, "-", test, True, "entered")
+                for ch, test in (("CX", "stepwise on the CX mismatch"), ("Cm", "stepwise on the Cm mismatch"),
+                                 ("de", "delay scan of de + stepwise"), ("CZ", "stepwise on the CZ mismatch"),
+                                 ("Cn", "stepwise on the Cn mismatch"), ("q", "kinematic"))]
+    moved = np.r_[np.full(300, 0.3), np.full(300, 0.6)]
+    p = SimpleNamespace(recording=_throttle_recording(moved))
+    cs = cands()
+    withhold_on_moving_throttle(cs, p, propeller)
+    withheld = {c.channel for c in cs if not c.selected}
+    assert withheld == ({"CX", "Cm", "de", "Cn"} if propeller else {"CX", "Cm", "de"})
+    assert all(c.reason == NOT_WITH_THROTTLE for c in cs if not c.selected)
+    cs = cands()
+    withhold_on_moving_throttle(cs, SimpleNamespace(recording=_throttle_recording(np.full(600, 0.6))), propeller)
+    assert all(c.selected for c in cs)

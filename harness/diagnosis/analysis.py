@@ -19,7 +19,8 @@ from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_par
                                             steady_vane, withhold_offset_of_a_scaled_vane)
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
-                                             stepwise_fits, vane_noise_columns, withhold_thrust_drift)
+                                             stepwise_fits, vane_noise_columns, withhold_on_moving_throttle,
+                                             withhold_thrust_drift)
 from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
@@ -77,12 +78,14 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # the vane-against-inertial difference, after the sensor corrections when there were any
     wander_gust = turbulence_test(p)[0] if sensor_values else gust
     vane = vane_noise_columns(p, along, slope_of, V0, mismatch, wander_gust)
-    step = stepwise_fits(p, has_propeller(aircraft.model), aero, measured, mismatch, delays, vane)
+    propeller = has_propeller(aircraft.model)
+    step = stepwise_fits(p, propeller, aero, measured, mismatch, delays, vane)
     cands += aero_candidates(step.selections, delays, p.dt, step.shares)
-    if not has_propeller(aircraft.model):
+    if not propeller:
         withhold_thrust_drift(cands, p, aero.trim)
     if step.pinned is not None:
         cands.append(pinned_shift(step.pinned))
+    withhold_on_moving_throttle(cands, p, propeller)
     # the rules that keep a term from being named when something else would imitate it
     withhold_explained_by_cg(cands, step.selections, mismatch, p)
     withhold_explained_by_lift(cands, step.selections, mismatch, p)

@@ -216,6 +216,25 @@ def _channels(rec: Recording) -> dict[str, np.ndarray]:
     return out
 
 
+# A recorded throttle (0-1) whose travel exceeds this changed the thrust the recording does not
+# carry: 5 % of the lever, a change of the order of 5-10 % of the engine's thrust range (no
+# lever's position noise comes near it; a held throttle's channel is constant).
+THROTTLE_STEADY = 0.05
+THROTTLE_MOVED = ("the recorded throttle moved from {:.2f} to {:.2f} of its travel: the thrust was not constant, "
+                  "and the terms its change would imitate are not named (not_checked)")
+
+
+def throttle_travel(rec: Recording) -> tuple[float, float] | None:
+    """The recorded throttle's range (its 1st and 99th percentiles, so that a spike does not
+    count) when the recording has a ``throttle_1`` channel and no thrust channel and the
+    throttle moved more than :data:`THROTTLE_STEADY`; None otherwise (thrust recorded, no
+    throttle channel, or the throttle held)."""
+    if "throttle_1" not in rec.data.columns or any(c.startswith("thrust_") for c in rec.data.columns):
+        return None
+    lo, hi = (float(v) for v in np.percentile(rec.data["throttle_1"].to_numpy(dtype=float), [1.0, 99.0]))
+    return (lo, hi) if hi - lo > THROTTLE_STEADY else None
+
+
 def interior_slice(n: int, dt: float) -> slice:
     """The samples of an ``n``-sample record at step ``dt`` without its first and last
     :data:`EDGE_S`."""
@@ -282,7 +301,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     if t[-1] < 4.0:
         raise UserError(f"recording {rec.name!r} is {t[-1]:.1f} s long; the diagnosis needs at least 4 s")
     dt = float((t[-1] - t[0]) / (t.size - 1))
-    assumptions = list(_stand_ins(raw, rec.meta, tuple(rec.data.columns)))
+    assumptions = list(_stand_ins(raw, rec.meta, tuple(rec.data.columns), throttle_travel(rec)))
     fits, filtered = _own_smoothing(raw, dt)
     if filtered:
         assumptions.append({"item": "noise floor", "missing": "a flat (white) noise floor to the Nyquist frequency",
@@ -387,17 +406,22 @@ def _own_smoothing(raw: dict[str, np.ndarray], dt: float) -> tuple[dict, list[st
     return fits, filtered
 
 
-def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...]) -> list[dict]:
+def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...],
+               throttle: tuple[float, float] | None = None) -> list[dict]:
     """What the recording leaves out and what the diagnosis assumes instead (altitude is
-    handled in :func:`prepare`; thrust's value is the analysis's)."""
+    handled in :func:`prepare`; thrust's value is the analysis's); ``throttle`` is
+    :func:`throttle_travel`'s range, when the recorded throttle contradicts the constant thrust."""
     out = []
     if "thrust" not in raw:
         trim_thrust = (meta.get("trim") or {}).get("thrust_lbf")
-        out.append({"item": "thrust", "missing": "thrust channel",
-                    "stood_in_by": (f"constant at the metadata's trim thrust, {trim_thrust:.0f} lbf "
-                                    "(recording-format: constant at trim)" if trim_thrust is not None else
-                                    "constant at the model's trim thrust at the recording's start "
-                                    "(recording-format: constant at trim; the metadata give none)")})
+        entry = {"item": "thrust", "missing": "thrust channel",
+                 "stood_in_by": (f"constant at the metadata's trim thrust, {trim_thrust:.0f} lbf "
+                                 "(recording-format: constant at trim)" if trim_thrust is not None else
+                                 "constant at the model's trim thrust at the recording's start "
+                                 "(recording-format: constant at trim; the metadata give none)")}
+        if throttle is not None:
+            entry["contradicted_by"] = THROTTLE_MOVED.format(*throttle)
+        out.append(entry)
     if "thrust_offset_ft" not in meta:
         out.append({"item": "thrust line", "missing": "thrust_offset_ft",
                     "stood_in_by": "through the c.g. (0 ft): a thrust line off it puts thrust × offset / (q̄·S·c̄) "

@@ -14,7 +14,7 @@ from harness.diagnosis.along import ModelAlong, interior
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import turbulence_test
 from harness.diagnosis.kinematics import PRACTICAL
-from harness.diagnosis.prepare import COEFFICIENTS, Prepared
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, throttle_travel
 from models.constants import SURFACES
 from models.replay import AeroAlong
 from models.trim import TrimPoint
@@ -331,6 +331,29 @@ def withhold_thrust_drift(cands: list[Candidate], p: Prepared, trim: TrimPoint) 
             c.selected, c.reason = False, f"not named: {why}"
         elif c.selected:
             c.reason += f"; {why}, under this one by more than two standard errors"
+
+
+def withhold_on_moving_throttle(cands: list[Candidate], p: Prepared, propeller: bool) -> None:
+    """When the recorded throttle moved and thrust was not recorded (:func:`throttle_travel`),
+    deselect every candidate fitted to the mismatch of an axis the thrust's change enters (its
+    terms, a moment-reference shift, the delay of its surface): C_X (its
+    force) and C_m (its moment through the thrust line), and behind a propeller C_l and C_n as
+    well (torque, P-factor, slipstream over the tail). The model holds thrust at trim, so the
+    mismatch there carries the change, in the shape of whatever followed the throttle."""
+    travel = p.recording is not None and throttle_travel(p.recording)
+    if not travel:
+        return
+    channels = THROTTLE_CHANNELS + (PROPELLER_THROTTLE_CHANNELS if propeller else ())
+    for c in cands:
+        if c.selected and c.channel in channels:
+            c.selected, c.reason = False, NOT_WITH_THROTTLE
+
+
+# The mismatch axes a thrust change enters, and the surfaces whose delays are fitted to them.
+THROTTLE_CHANNELS = ("CX", "Cm", "de")
+PROPELLER_THROTTLE_CHANNELS = ("Cl", "Cn", "da", "dr")
+NOT_WITH_THROTTLE = ("not named: the throttle moved and thrust was not recorded; the model held thrust at trim, so "
+                     "this axis's mismatch carries the thrust's change (record thrust_lbf)")
 
 
 # How fast a jet's thrust may change with airspeed at a fixed throttle, |d ln T / d ln V|, for

@@ -10,8 +10,9 @@ from harness.diagnosis.along import interior
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.gust_rules import NOT_IN_GUSTS, NOT_IN_TURBULENCE, vane_wander
 from harness.diagnosis.kinematics import time_base_problem
-from harness.diagnosis.prepare import COEFFICIENTS, Prepared, undriven_reason
+from harness.diagnosis.prepare import COEFFICIENTS, Prepared, throttle_travel, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
+from harness.diagnosis.stepwise_axes import NOT_WITH_THROTTLE
 from harness.diagnosis.sensor_rules import steady_vane, steady_vane_reason
 from models.aircraft import Aircraft, other_fcs_properties
 from models.constants import SURFACES
@@ -424,6 +425,7 @@ def not_checked(a: Analysis, validation_given: bool) -> list[dict]:
     if a.gusty:
         out += [{"effect": e, "parameters": [], "reason": a.gusty} for e in SENSOR_EFFECTS]
     out += in_turbulence(a)
+    out += _withheld_for_throttle(a)
     if vane_wander(a.air, a.gusty):
         out.append({"effect": "coefficient_error", "parameters": ["terms in alpha, its powers and alphadot"],
                     "reason": a.gusty})
@@ -455,6 +457,20 @@ def in_turbulence(a: Analysis) -> list[dict]:
              for e in SENSOR_EFFECTS]
             + [_withheld(a.candidates, e, NOT_IN_GUSTS, "terms fitted to the coefficient mismatch are " + NOT_IN_GUSTS,
                          "those listed entered and were withheld") for e in terms])
+
+
+def _withheld_for_throttle(a: Analysis) -> list[dict]:
+    """``not_checked`` entries when the throttle moved with no thrust channel: the terms of the
+    axes its change enters, those withheld for it listed
+    (:func:`~harness.diagnosis.stepwise_axes.withhold_on_moving_throttle`)."""
+    if a.prepared.recording is None or throttle_travel(a.prepared.recording) is None:
+        return []
+    because = ("terms of CX and Cm (and of Cl and Cn behind a propeller) are not named: the throttle moved and "
+               "thrust was not recorded; the model held thrust at trim, so their mismatch carries the thrust's change "
+               "(record thrust_lbf)")
+    effects = sorted({c.effect for c in a.candidates if c.reason == NOT_WITH_THROTTLE} | {"coefficient_error"})
+    return [_withheld(a.candidates, e, NOT_WITH_THROTTLE, because, "those listed entered and were withheld")
+            for e in effects]
 
 
 def _withheld(cands: list[Candidate], effect: str, reason: str, because: str, listed: str) -> dict:
