@@ -1611,3 +1611,27 @@ def test_terms_a_thrust_change_imitates_are_withheld_when_the_throttle_moved_unr
     cs = cands()
     withhold_on_moving_throttle(cs, SimpleNamespace(recording=_throttle_recording(np.full(600, 0.6))), propeller)
     assert all(c.selected for c in cs)
+
+
+@pytest.mark.parametrize("cz_std_error, caveat", [(0.05, True), (0.01, False)])
+def test_a_named_control_derivative_says_a_surface_position_scale_would_read_as_it(cz_std_error, caveat):
+    """A C_m,δe change f = −10 % is a δe position scale k = −f/(1 + f) = +0.111 unless another
+    δe derivative moved by other than f of its model value beyond SURFACE_SCALE_Z standard
+    errors: C_Z,δe changed −0.04 where the scale predicts +0.04 (model −0.4) is 1.6 standard
+    errors off at ±0.05 (the caveat stays) and 8 at ±0.01 (the scale is ruled out)."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.term_rules import note_surface_scale
+
+    def coefficient(name, model, change, se, selected):
+        return Candidate("coefficient_error", "pitch", name.split("_")[0], name, model + change, se, change / se, 0.3,
+                         "per rad", "stepwise", selected, "entered",
+                         {"change": change, "model_over_maneuver": model, "model_at_trim": model})
+    cm = coefficient("Cm_de", -0.5, 0.05, 0.003, True)
+    cz = coefficient("CZ_de", -0.4, -0.04, cz_std_error, False)
+    note_surface_scale([cm, cz, coefficient("Cm_alpha", -0.3, 0.05, 0.003, True)])
+    scale = cm.details["surface_scale"]
+    assert scale["scale"] == pytest.approx(0.1 / 0.9) and scale["fraction"] == pytest.approx(-0.1)
+    assert scale["tested_by"]["CZ_de"]["scale_predicts"] == pytest.approx(0.04)
+    assert scale["ruled_out"] is not caveat
+    assert ("de position-sensor scale error of +0.111" in cm.details.get("not_ruled_out", "")) is caveat
+    assert "surface_scale" not in cz.details

@@ -21,7 +21,8 @@ from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns, withhold_on_moving_throttle,
                                              withhold_thrust_drift)
-from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, note_untested_coupling,
+from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, note_surface_scale,
+                                          note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
                                           withhold_explained_by_cg, withhold_explained_by_lift,
@@ -96,6 +97,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
                     measured)
     note_untested_coupling(cands, p)
+    note_surface_scale(cands)
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
     imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
     withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin), contested)

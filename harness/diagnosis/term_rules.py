@@ -22,6 +22,7 @@ from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYRO_UNIT, GYROS, kinem
                                             suspected_estimate, unit_members)
 from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test, vane_error_column
 from models.aircraft import Aircraft
+from models.constants import SURFACES
 from models.replay import InitialCondition
 
 
@@ -351,6 +352,53 @@ def note_untested_coupling(cands: list[Candidate], p: Prepared) -> None:
                   "the start); only a maneuver moving α and β together tells the two apart")
         prior = c.details.get("not_ruled_out")
         c.details["not_ruled_out"] = f"{prior}; {caveat}" if prior else caveat
+
+
+def note_surface_scale(cands: list[Candidate]) -> None:
+    """Say, on a named control derivative (``Cm_de``, ``Cl_da`` ...), that a scale error of
+    that surface's position sensor would read as it, unless the recording rules that out.
+
+    The recorded deflection δ_r = (1 + k)·δ makes every term in δ look 1/(1 + k) times its
+    size, on every axis at once: a change f = ΔC_δ/C_δ of one derivative is a scale
+    k = −f/(1 + f) when the surface's other derivatives moved by the same fraction. Each other
+    derivative of the surface the stepwise fitted (selected or not) tests that: one whose change
+    lies more than :data:`SURFACE_SCALE_Z` standard errors from f times its model value rules
+    the scale out (the evidence says which); otherwise the caveat gives the k that would take
+    and how well the others were measured. Probe 65: a 10 % stabilator position scale on F-16,
+    737 and c172x multisines was named C_m,δe −9 % (t 8-18) with C_Z,δe measured to ±0.05-0.09,
+    no test of a 9 % change of −0.4."""
+    fitted = {c.parameter: c for c in cands
+              if c.effect == "coefficient_error" and c.details.get("model_over_maneuver") and c.std_error > 0}
+    for c in cands:
+        coefficient, _, surface = c.parameter.rpartition("_")
+        if not (c.selected and c.parameter in fitted and surface in SURFACES):
+            continue
+        f = c.details["change"] / c.details["model_over_maneuver"]
+        if f <= -1.0:
+            continue
+        k = -f / (1.0 + f)
+        others = [(o.parameter, o.details["change"], o.std_error, f * o.details["model_over_maneuver"])
+                  for o in fitted.values() if o is not c and o.parameter.endswith(f"_{surface}")]
+        refuting = [x for x in others if abs(x[1] - x[3]) > SURFACE_SCALE_Z * x[2]]
+        c.details["surface_scale"] = {"scale": k, "fraction": f,
+                                      "tested_by": {n: {"change": d, "std_error": se, "scale_predicts": e}
+                                                    for n, d, se, e in others},
+                                      "ruled_out": bool(refuting)}
+        if refuting:
+            continue
+        seen = "; ".join(f"{n} changed {d:+.3g} ± {se:.2g} where the scale predicts {e:+.3g}" for n, d, se, e in others)
+        caveat = (f"a {surface} position-sensor scale error of {k:+.3g} (recorded = (1 + k) × true) would read as this "
+                  f"change, with the surface's other derivatives moved by the same fraction ({100 * f:+.1f} %)"
+                  + (f", which this recording cannot rule out ({seen})" if seen else
+                     ", which this recording does not test (no other derivative of it fitted)")
+                  + "; a calibration of the surface position tells them apart")
+        prior = c.details.get("not_ruled_out")
+        c.details["not_ruled_out"] = f"{prior}; {caveat}" if prior else caveat
+
+
+# A control derivative's change rules a position-sensor scale out when another derivative of
+# the same surface lies this many standard errors from the same fractional change.
+SURFACE_SCALE_Z = 3.0
 
 
 def _refuted_shift(rival: rivals.Rival | None, by_key: dict, axis: str, p: Prepared, selections: dict,
