@@ -1635,3 +1635,18 @@ def test_a_named_control_derivative_says_a_surface_position_scale_would_read_as_
     assert scale["ruled_out"] is not caveat
     assert ("de position-sensor scale error of +0.111" in cm.details.get("not_ruled_out", "")) is caveat
     assert "surface_scale" not in cz.details
+
+
+def test_variance_inflation_is_one_over_one_minus_r_squared_and_a_geared_surface_keeps_its_trim_derivative():
+    """Two regressors correlated r have VIF 1/(1 − r²) each (exactly, for sample correlation
+    r); a column the others reproduce exactly is infinite. effective_derivatives then leaves
+    a regressor beyond COLLINEAR_VIF out, so library() falls back on its trim derivative."""
+    from harness.diagnosis.candidates import COLLINEAR_VIF, variance_inflation
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=2000)
+    y = 0.6 * x + 0.8 * rng.normal(size=2000)
+    r = np.corrcoef(x, y)[0, 1]
+    vif = variance_inflation(np.column_stack([x, y, np.ones_like(x)]))
+    assert vif == pytest.approx([1.0 / (1.0 - r * r)] * 2, rel=1e-9)
+    geared = np.column_stack([x, 0.5 * x, y, np.ones_like(x)])
+    assert np.all(variance_inflation(geared)[:2] > 1e12) and variance_inflation(geared)[2] < COLLINEAR_VIF

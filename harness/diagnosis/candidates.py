@@ -94,7 +94,30 @@ def effective_derivatives(p: Prepared, axis: str, model: np.ndarray) -> dict[str
     inner = interior_slice(p.n, p.dt)
     A = np.column_stack([reg[r][inner] for r in names] + [np.ones(inner.stop - inner.start)])
     theta, *_ = np.linalg.lstsq(A, model[inner], rcond=None)
-    return {f"{axis}_{r}": float(v) for r, v in zip(names, theta)}
+    inflation = variance_inflation(A)
+    return {f"{axis}_{r}": float(v) for r, v, vif in zip(names, theta, inflation) if vif <= COLLINEAR_VIF}
+
+
+def variance_inflation(A: np.ndarray) -> np.ndarray:
+    """Each column's variance inflation factor in ``A`` (its last column the constant):
+    1 / (1 − R²) of the column regressed on all the others, the factor by which collinearity
+    inflates its coefficient's variance (infinite for a column the others reproduce)."""
+    out = []
+    for j in range(A.shape[1] - 1):
+        x, others = A[:, j], np.delete(A, j, axis=1)
+        fit, *_ = np.linalg.lstsq(others, x, rcond=None)
+        residual = float(np.sum((x - others @ fit) ** 2))
+        total = float(np.sum((x - np.mean(x)) ** 2))
+        out.append(total / residual if residual > 0.0 else float("inf"))
+    return np.array(out)
+
+
+# A regressor whose variance inflation factor exceeds this (two columns correlated beyond
+# 0.995) has no effective derivative of its own: the least-squares split between it and the
+# columns that reproduce it is arbitrary (probe 66: a rudder geared to the aileron gave the
+# c172x an "effective" C_n,δr of +0.048 where its trim derivative is −0.042, and a finding
+# sized from it). It keeps its trim derivative.
+COLLINEAR_VIF = 100.0
 
 
 # The derivatives a coefficient error is offered on, per axis group (seed Eqs. 6-11).
