@@ -336,12 +336,11 @@ def withhold_thrust_drift(cands: list[Candidate], p: Prepared, trim: TrimPoint) 
 def withhold_on_moving_throttle(cands: list[Candidate], p: Prepared, propeller: bool) -> None:
     """When the recorded throttle moved and thrust was not recorded (:func:`throttle_travel`),
     deselect every candidate fitted to the mismatch of an axis the thrust's change enters (its
-    terms, a moment-reference shift, the delay of its surface): C_X (its
-    force) and C_m (its moment through the thrust line), and behind a propeller C_l and C_n as
-    well (torque, P-factor, slipstream over the tail). The model holds thrust at trim, so the
-    mismatch there carries the change, in the shape of whatever followed the throttle."""
-    travel = p.recording is not None and throttle_travel(p.recording)
-    if not travel:
+    terms, a moment-reference shift, the delay of its surface): C_X (its force) and C_m (its
+    moment through the thrust line), and behind a propeller C_l and C_n as well (torque,
+    P-factor, slipstream over the tail). The model holds thrust at trim, so the mismatch there
+    carries the change, in the shape of whatever followed the throttle."""
+    if p.recording is None or throttle_travel(p.recording) is None:
         return
     channels = THROTTLE_CHANNELS + (PROPELLER_THROTTLE_CHANNELS if propeller else ())
     for c in cands:

@@ -12,8 +12,8 @@ from harness.diagnosis.gust_rules import NOT_IN_GUSTS, NOT_IN_TURBULENCE, vane_w
 from harness.diagnosis.kinematics import time_base_problem
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, throttle_travel, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
-from harness.diagnosis.stepwise_axes import NOT_WITH_THROTTLE
 from harness.diagnosis.sensor_rules import steady_vane, steady_vane_reason
+from harness.diagnosis.stepwise_axes import NOT_WITH_THROTTLE
 from models.aircraft import Aircraft, other_fcs_properties
 from models.constants import SURFACES
 
