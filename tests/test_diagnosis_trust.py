@@ -1650,3 +1650,40 @@ def test_variance_inflation_is_one_over_one_minus_r_squared_and_a_geared_surface
     assert vif == pytest.approx([1.0 / (1.0 - r * r)] * 2, rel=1e-9)
     geared = np.column_stack([x, 0.5 * x, y, np.ones_like(x)])
     assert np.all(variance_inflation(geared)[:2] > 1e12) and variance_inflation(geared)[2] < COLLINEAR_VIF
+
+
+def _long_record_case(shift: bool):
+    """A 90 s record at 50 Hz whose stabilator moves over 1-21 s; the C_X mismatch is either a
+    level that differs between the maneuver and the quiet flight after it (``shift``) or a
+    true α² term, with white noise."""
+    from types import SimpleNamespace
+    from harness.diagnosis.evidence import Candidate
+    rng = np.random.default_rng(7)
+    t = np.arange(4500) * 0.02
+    on = (t > 1.0) & (t < 21.0)
+    de = np.where(on, 0.05 * np.sin(2 * np.pi * 0.5 * t), 0.0)
+    alpha = np.where(on, 0.02 * np.sin(2 * np.pi * 0.5 * t + 0.3), 0.0)
+    z = (np.where(t < 22.0, -0.0004, 0.0) if shift else -3.0 * alpha ** 2) + rng.normal(scale=1e-4, size=t.size)
+    p = SimpleNamespace(n=t.size, dt=0.02, driven=("alpha", "q", "de"), smooth={"de": de}, start={"de": 0.0})
+    term = SimpleNamespace(column=alpha ** 2, parameter="CX_alpha2")
+    step = SimpleNamespace(selections={"CX": (SimpleNamespace(names=["alpha2"]), {"alpha2": term})}, nuisances={})
+    c = Candidate("nonlinear_alpha", "lon", "CX", "CX_alpha2", -3.0, 0.5, -6.0, 0.1, "per rad^2",
+                  "stepwise on the CX mismatch", True, "entered")
+    return p, step, {"CX": z}, c
+
+
+@pytest.mark.parametrize("shift", [True, False])
+def test_an_alpha_square_must_hold_inside_the_maneuver_window_of_a_long_record(shift):
+    """maneuver_window is 1 s before to 8 s after the inputs (0-29 s of 90 s); a level shift
+    between the maneuver and the quiet flight after it, which an α² column fits over the whole
+    record, has no α² shape inside it (withheld), a true α² keeps its t there (named); a
+    maneuver filling 70 % of the record gives no window."""
+    from harness.diagnosis.term_rules import maneuver_window, withhold_even_term_off_the_quiet_flight
+    p, step, mismatch, c = _long_record_case(shift)
+    window = maneuver_window(p)
+    assert window.start * p.dt == pytest.approx(0.0, abs=0.1) and window.stop * p.dt == pytest.approx(29.0, abs=0.1)
+    withhold_even_term_off_the_quiet_flight([c], step, p, mismatch)
+    assert c.selected is not shift
+    assert ("only beside the quiet flight" in c.reason) is shift
+    p.smooth["de"], p.n = p.smooth["de"][:1500], 1500
+    assert maneuver_window(p) is None

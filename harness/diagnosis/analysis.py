@@ -25,6 +25,7 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
+                                          withhold_even_term_off_the_quiet_flight,
                                           withhold_explained_by_cg, withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane, withhold_rivals)
@@ -92,6 +93,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_explained_by_lift(cands, step.selections, mismatch, p)
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
+    withhold_even_term_off_the_quiet_flight(cands, step, p, mismatch)
     withhold_force_drift_off_the_vane_wander(cands, step, p, mismatch, slope_of, wander_gust, V0)
     withhold_off_the_integration_drift(cands, step, p, mismatch)
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,

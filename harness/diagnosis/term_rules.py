@@ -254,6 +254,68 @@ def withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: St
                         f"wander, which favours a power of α), t = {fit[1]:.1f}")
 
 
+def withhold_even_term_off_the_quiet_flight(cands: list[Candidate], step: StepwiseFits, p: Prepared,
+                                            mismatch: dict[str, np.ndarray]) -> None:
+    """A named term even in its state (α², |β|: :data:`EVEN_TERMS`) must stay significant
+    refitted on the maneuver's own window (:func:`maneuver_window`) when the record runs on
+    well past the inputs.
+
+    Such a column has a mean wherever the maneuver moves its state and almost none in the
+    quiet flight after it, so over a record much longer than its maneuver it fits any
+    difference between the mismatch's level during the maneuver and after it, a slow drift
+    that the colored standard error (Eq. 40, estimated over the whole record as if the
+    residuals were stationary) does not cover. Inside the window only the term's shape
+    within the maneuver carries it, beside the axis's other entered terms and nuisances.
+    Probe 70: a c172x null, a 20 s pitch multisine in a 90 s record, was named C_X α² −2.8
+    (t −5.6; another seed −4.2, t −6.1): white gyro noise alone on its noise-free flight
+    gave −2.4 at t −6.9."""
+    window = maneuver_window(p)
+    if window is None:
+        return
+    for c in cands:
+        if not (c.selected and c.channel in step.selections):
+            continue
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
+        if key not in EVEN_TERMS:
+            continue
+        others = [by_key[k].column[window] for k in sel.names if k in by_key and k != key]
+        others += [v[window] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[window]) > 0]
+        fit = _refit_term(mismatch[c.channel][window], others, by_key[key].column[window])
+        if fit is None or abs(fit[1]) < cand.T_IN:
+            c.selected = False
+            c.reason = ("entered, but only beside the quiet flight after the maneuver: refitted on the maneuver's "
+                        f"{(window.stop - window.start) * p.dt:.0f} s of a {p.n * p.dt:.0f} s record, "
+                        + (f"t = {fit[1]:.1f}" if fit is not None else "its column is dependent there"))
+
+
+EVEN_TERMS = ("alpha2", "beta_abs")
+
+
+def maneuver_window(p: Prepared) -> slice | None:
+    """The samples from :data:`WINDOW_BEFORE_S` before the first to :data:`WINDOW_AFTER_S`
+    after the last sample at which a surface the maneuver drove stands more than a tenth of
+    its largest excursion from its start; None when that window covers at least
+    :data:`WINDOW_SHARE` of the record (the maneuver fills it) or no surface was driven."""
+    moved = np.zeros(p.n, dtype=bool)
+    for s in SURFACES:
+        if s in p.driven and s in p.smooth:
+            excursion = np.abs(p.smooth[s] - p.start[s])
+            moved |= excursion > 0.1 * float(np.max(excursion))
+    if not moved.any():
+        return None
+    first, last = np.nonzero(moved)[0][[0, -1]]
+    lo = max(0, int(first - WINDOW_BEFORE_S / p.dt))
+    hi = min(p.n, int(last + WINDOW_AFTER_S / p.dt) + 1)
+    return None if hi - lo >= WINDOW_SHARE * p.n else slice(lo, hi)
+
+
+# The maneuver's window (maneuver_window): a second before its inputs, eight seconds after
+# them (an airliner's short period and the first of its Dutch roll die out in that); a window
+# of 70 % of the record or more is the record.
+WINDOW_BEFORE_S, WINDOW_AFTER_S, WINDOW_SHARE = 1.0, 8.0, 0.7
+
+
 def kinematic_bias_of(kin: KinematicResult, channel: str, applied: set[str]) -> tuple[float, float]:
     """The kinematic estimate of a vane bias and its standard error (0 ± s.e. once the
     channels were corrected for it); an infinite s.e. when the check had no such bias."""
