@@ -1687,3 +1687,27 @@ def test_an_alpha_square_must_hold_inside_the_maneuver_window_of_a_long_record(s
     assert ("only beside the quiet flight" in c.reason) is shift
     p.smooth["de"], p.n = p.smooth["de"][:1500], 1500
     assert maneuver_window(p) is None
+
+
+def test_the_model_is_limited_to_the_common_filter_band_so_a_square_adds_no_mismatch():
+    """band_limit keeps every sine coefficient the common filter passes and drops the rest: a
+    record built of sines below the cut-off passes exactly, the square of a 0.8 Hz sine (its
+    2·0.8 = 1.6 Hz part above a 1.1 Hz cut-off) keeps only its mean. So C = α² of a filtered
+    α, band-limited, is what the filter leaves of the true α²."""
+    from types import SimpleNamespace
+    from estimators.smoothing import sine_series_filter
+    from harness.diagnosis.along import band_limit
+    n, dt = 2001, 0.02
+    t = np.arange(n) * dt
+    freqs = np.arange(1, n - 1) / (2 * (n - 1) * dt)        # sine-series frequencies, Hz
+    weights = np.clip((1.1 - freqs) / 0.3, 0.0, 1.0)         # a Wiener-like taper ending at 1.1 Hz
+    band = band_limit(SimpleNamespace(weights=weights))
+    assert set(np.unique(band)) == {0.0, 1.0} and np.all((band == 1.0) == (weights > 1e-6))
+    low = np.sin(np.pi * 40 * t / t[-1]) + 0.5 * np.sin(np.pi * 70 * t / t[-1])  # 0.5 and 0.875 Hz, exact sine terms
+    assert np.allclose(sine_series_filter(low, band), low, atol=1e-9)
+    alpha = 0.02 * np.sin(np.pi * 64 * t / t[-1])                               # 0.8 Hz
+    square = sine_series_filter(alpha ** 2, band)            # 0.0002 (1 - cos 2wt): its 1.6 Hz part goes
+    constant = sine_series_filter(np.full(n, 2e-4), band)
+    inner = (t > 5.0) & (t < t[-1] - 5.0)                   # clear of the series' end effects
+    assert np.max(np.abs(square - constant)[inner]) < 0.05 * 2e-4
+    assert np.max(np.abs(alpha ** 2 - constant)[inner]) > 0.9 * 2e-4  # unfiltered, the 1.6 Hz part is all there

@@ -9,6 +9,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from estimators.smoothing import sine_series_filter
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles
@@ -96,9 +97,30 @@ class ModelAlong(NamedTuple):
     alphadot: np.ndarray | None
     aero: AeroAlong
     measured: dict[str, np.ndarray]
+    band: np.ndarray | None = None  # sine-series weights of the common filter's band (band_limit)
 
     def mismatch(self) -> dict[str, np.ndarray]:
-        return {c: self.measured[c] - self.aero.coefficients[c] for c in COEFFICIENTS}
+        """Measured less model coefficients, the model's limited to the common filter's band
+        (:func:`band_limit`)."""
+        model = self.aero.coefficients
+        if self.band is not None:
+            model = {c: sine_series_filter(model[c], self.band) for c in COEFFICIENTS}
+        return {c: self.measured[c] - model[c] for c in COEFFICIENTS}
+
+
+def band_limit(p: Prepared) -> np.ndarray:
+    """The common filter's band as sine-series weights of 0 and 1: every coefficient the
+    common filter passes at all (weight over 1e-6) is kept whole, the rest removed.
+
+    The measured coefficients are Eqs. 1-5 on the filtered channels, so they hold nothing
+    above the common cut-off; the model, evaluated on the filtered states, holds nothing there
+    either while it is linear, but its quadratic terms (a drag polar's α², an |β|) carry the
+    sum frequencies of the maneuver's own, up to twice its band. Left in, they are a mismatch
+    of the opposite sign that an α² column fits (probe 71: a noise-free 90 s c172x pitch
+    multisine, 0.2-0.9 Hz, given white p and r noise that put the cut-off at 1.1 Hz, drew C_X α²
+    −2.4 at t −6.9). A band of ones below the cut-off leaves everything the states carry alone,
+    so a linear model's mismatch is untouched."""
+    return (p.weights > 1e-6).astype(float)
 
 
 def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
@@ -110,7 +132,7 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
     alphadot = cand.alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
     aero = aero_along(aircraft, ic, states, surfaces, alphadot)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
-    return ModelAlong(states, surfaces, alphadot, aero, measured)
+    return ModelAlong(states, surfaces, alphadot, aero, measured, band_limit(p))
 
 
 # What the inertial sideslip is integrated from (kinematics.inertial_angles).

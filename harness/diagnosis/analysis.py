@@ -62,7 +62,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     recorded, p = p, corrected_recording(p, kin, sensor_values)
     # 2. the model along the measured states
     along = model_along(p, aircraft, ic)
-    states, surfaces, alphadot, aero, measured = along
+    states, surfaces, alphadot, aero, measured = along[:5]
     mismatch = along.mismatch()
     slope_of = slope_function(aircraft, ic, states, surfaces, alphadot, aero)
     # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)
