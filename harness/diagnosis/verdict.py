@@ -476,7 +476,8 @@ def _withheld_for_throttle(a: Analysis) -> list[dict]:
 def _withheld(cands: list[Candidate], effect: str, reason: str, because: str, listed: str) -> dict:
     """A ``not_checked`` entry: ``effect``'s candidates withheld for ``reason``, and why."""
     names = sorted(c.parameter for c in cands if c.effect == effect and c.reason == reason)
-    return {"effect": effect, "parameters": names, "reason": because + (f"; {listed} (see candidates)" if names else "")}
+    return {"effect": effect, "parameters": names,
+            "reason": because + (f"; {listed} (see candidates)" if names else "")}
 
 
 def assumptions(a: Analysis, aircraft: Aircraft, mass: str, surfaces_note: dict | None = None) -> list[dict]:
