@@ -300,7 +300,8 @@ def test_an_alpha_scale_is_not_read_as_a_power_of_alpha(tmp_path):
     along the scaled vane carries its nonlinear slope times 0.1 α, which a C_X α² fitted
     (−0.73, confirmed by the validation doublets). The kinematics suspect the scale (t 5.6), as
     for the C_Z,α change beside it: a term in α's powers is asked of the α sensor's suspected
-    error too, and is not named."""
+    error too, and is not named. (Since the model's band limit, twenty-fifth session, the C_X α²
+    estimate is smaller and the C_Z change's share of C_X, read as lift, withholds it first.)"""
     import jsbsim
     c172x = str(Path(jsbsim.get_default_root_dir()) / "aircraft" / "c172x" / "c172x.xml")
     rec = fly(tmp_path / "id.csv", "c172x", 6000.0, 190.0, 302, 50.0, "ms_pitch", amplitude_deg=5.0)
@@ -310,7 +311,8 @@ def test_an_alpha_scale_is_not_read_as_a_power_of_alpha(tmp_path):
     result = diagnose(c172x, rec, tmp_path / "out", val, calibrate=False)
     assert {p for p, _ in _found(result)} <= {"scale_alpha"}
     power = next(c for c in result["candidates"] if c["parameter"] == "CX_alpha2")
-    assert not power["selected"] and "scale_alpha" in power["reason"], power["reason"]
+    assert not power["selected"], power["reason"]
+    assert "scale_alpha" in power["reason"] or "change of lift" in power["reason"], power["reason"]
 
 
 def test_an_alpha_scale_the_kinematics_cannot_see_is_not_named_a_lift_slope(tmp_path):
