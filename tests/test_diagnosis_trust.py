@@ -1652,6 +1652,23 @@ def test_variance_inflation_is_one_over_one_minus_r_squared_and_a_geared_surface
     assert np.all(variance_inflation(geared)[:2] > 1e12) and variance_inflation(geared)[2] < COLLINEAR_VIF
 
 
+def test_a_geared_surface_gets_no_effective_derivative_of_its_own(monkeypatch):
+    """With the rudder geared to the aileron (dr = 0.5 da) the model's C_n regressed on β, p̂,
+    r̂, δa, δr cannot split δa from δr: effective_derivatives gives β, p̂ and r̂ their values
+    and leaves δa and δr out (library() then takes their trim derivatives)."""
+    from types import SimpleNamespace
+    from harness.diagnosis import candidates
+    rng = np.random.default_rng(5)
+    n = 1500
+    reg = {k: rng.normal(size=n) for k in ("beta", "phat", "rhat", "da")}
+    reg["dr"] = 0.5 * reg["da"]
+    monkeypatch.setattr(candidates, "regressors", lambda p: reg)
+    model = 0.2 * reg["beta"] - 0.3 * reg["phat"] - 0.8 * reg["rhat"] + 0.005 * reg["da"] - 0.04 * reg["dr"]
+    got = candidates.effective_derivatives(SimpleNamespace(n=n, dt=0.02), "Cn", model)
+    assert set(got) == {"Cn_beta", "Cn_phat", "Cn_rhat"}
+    assert got["Cn_beta"] == pytest.approx(0.2) and got["Cn_rhat"] == pytest.approx(-0.8)
+
+
 def _long_record_case(shift: bool):
     """A 90 s record at 50 Hz whose stabilator moves over 1-21 s; the C_X mismatch is either a
     level that differs between the maneuver and the quiet flight after it (``shift``) or a

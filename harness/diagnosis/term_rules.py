@@ -432,7 +432,7 @@ def note_surface_scale(cands: list[Candidate]) -> None:
     fitted = {c.parameter: c for c in cands
               if c.effect == "coefficient_error" and c.details.get("model_over_maneuver") and c.std_error > 0}
     for c in cands:
-        coefficient, _, surface = c.parameter.rpartition("_")
+        surface = c.parameter.rpartition("_")[2]
         if not (c.selected and c.parameter in fitted and surface in SURFACES):
             continue
         f = c.details["change"] / c.details["model_over_maneuver"]
