@@ -159,3 +159,38 @@ def test_axes_carrying_one_vane_wander_are_not_three_independent_tests():
     verdict = corroborate("vane_beta_x", 1.0, 0.3, ratios, t_aero=5.0)
     assert not verdict.named and "does not show it clearly" in verdict.reason
     assert verdict.ratio / verdict.ratio_std < 0.7 * independent[0] / independent[1]
+
+
+def test_a_scale_whose_mistrim_the_mismatch_lacks_is_refuted_by_the_mean():
+    """corroborate.mistrim_test: a scale error acts on the whole reading, so the model along it
+    is off at trim by the signature's mean (z = −a·Δ). A mismatch whose constant beside the
+    other terms lacks that mistrim is a change of the aerodynamics that vanishes at trim (an
+    independent script's lift change read as an α scale on C_X, C_Z and C_m); one that has
+    it, or more than it, leaves the scale named, and a signature without a mean (a bias's,
+    a skew's) is not tested."""
+    def axis(mean, sig_mean=0.02):
+        return AxisRatio("CZ", 1.0, 0.1, mean=mean, mean_se=0.002, signature_mean=sig_mean)
+
+    kinematic = (-0.08, 0.02)
+    lacking = corroborate("scale_alpha", *kinematic, {"CZ": axis(0.0)}, t_aero=5.0)
+    assert not lacking.named and lacking.reason.startswith("refuted by the mean of CZ")
+    assert corroborate("scale_alpha", *kinematic, {"CZ": axis(-0.02)}, t_aero=5.0).named
+    assert corroborate("scale_alpha", *kinematic, {"CZ": axis(-0.04)}, t_aero=5.0).named
+    assert corroborate("skew_q", *kinematic, {"CZ": axis(0.0, np.nan)}, t_aero=5.0).named
+    from harness.diagnosis.corroborate import MISTRIM_SHARE, mistrim_test
+    # short by less than the share of the prediction: not refuted
+    assert mistrim_test((axis(-0.02 * (1 - 0.9 * MISTRIM_SHARE)),), 1.0, 0.01) == ""
+
+
+def test_axis_ratio_reads_the_mismatch_constant_without_the_signature():
+    """The mean the mistrim test weighs is the mismatch's own constant beside the other terms
+    (the signature left out), and the signature's mean is kept beside the ratio."""
+    t = np.linspace(0.0, 10.0, 501)
+    signature = np.sin(1.3 * t) + 0.3
+    other = np.cos(0.7 * t)
+    z = 0.4 * other - 0.8 * (signature - 0.3)  # the perturbation without the mistrim
+    r = axis_ratio(z, [other], signature)
+    assert r.ratio == pytest.approx(0.8, abs=1e-10)
+    assert r.signature_mean == pytest.approx(float(np.mean(signature)))
+    expected = np.linalg.lstsq(np.column_stack([other, np.ones_like(t)]), z, rcond=None)[0][1]
+    assert r.mean == pytest.approx(float(expected), abs=1e-12)

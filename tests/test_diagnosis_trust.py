@@ -790,6 +790,63 @@ def test_a_vane_bias_that_is_a_scale_factors_offset_is_named_as_the_scale():
     assert bias.details["as_scale"]["k"] == pytest.approx(0.1)  # the reading the validation test uses
 
 
+def test_a_vane_bias_a_scale_would_make_is_withheld_when_the_excursions_cannot_tell():
+    """sensor_rules._withhold_bias_a_scale_would_make: a bias of 0.011 rad at a mean α of
+    0.121 rad reads as a scale of 0.100 ± 0.007. Where α moved too little for a scale to be
+    offered, or the excursions' reading (0.02 ± 0.04) lies within two standard errors of both
+    0 and 0.1, the bias is withheld (bias or scale); excursions that rule the scale out
+    (0.002 ± 0.01) leave it named, as does an offset no plausible scale makes (k 0.7)."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_rules import scale_read_as_bias
+    p = SimpleNamespace(smooth={"alpha": np.full(100, 0.121), "V": np.full(100, 450.0)}, dt=0.02)
+
+    def bias(b=0.011):
+        return Candidate("sensor_bias", None, "alpha", "bias_alpha", b, 0.0008, b / 0.0008, 0.0, "rad",
+                         "kinematic consistency (bias always fitted)", True, "significant, practical and precise")
+
+    def scale(k, se):
+        return Candidate("sensor_scale", None, "alpha", "scale_alpha", k, se, k / se, 0.01, "1",
+                         "kinematic consistency", False, "below the entry t")
+
+    alone = bias()
+    scale_read_as_bias([alone], p)
+    assert not alone.selected and "moved too little" in alone.reason
+    assert alone.details["scale_rival"]["offset_k"] == pytest.approx(0.1)
+    assert alone.details["scale_rival"]["excursion_k"] is None
+    vague = bias()
+    scale_read_as_bias([vague, scale(0.02, 0.04)], p)
+    assert not vague.selected and "bias or scale" in vague.reason
+    ruled_out = bias()
+    scale_read_as_bias([ruled_out, scale(0.002, 0.01)], p)
+    assert ruled_out.selected
+    large = bias(0.05)
+    scale_read_as_bias([large], p)
+    assert large.selected
+
+
+def test_a_vane_bias_the_kinematics_name_is_sized_on_the_coefficient_means_too():
+    """sensor_naming._size_on_both: the kinematics' 0.0317 ± 0.006 rad and the means'
+    0.0178 ± 0.0002 agree within three standard errors: the bias is their inverse-variance
+    mean; means that disagree (0.06) leave the kinematic size."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_naming import _size_on_both
+
+    def bias():
+        return Candidate("sensor_bias", None, "beta", "bias_beta", 0.0317, 0.006, 5.3, 0.0, "rad",
+                         "kinematic consistency (bias always fitted)", True, "significant, practical and precise")
+    both = bias()
+    _size_on_both(both, 0.0178, 0.0002, "CY 1.02°")
+    w = np.array([1 / 0.006 ** 2, 1 / 0.0002 ** 2])
+    assert both.estimate == pytest.approx(float(np.dot(w, [0.0317, 0.0178]) / w.sum()))
+    assert both.std_error == pytest.approx(1 / np.sqrt(w.sum()))
+    assert both.details["sized_on_both"]["kinematic"] == 0.0317 and "CY 1.02°" in both.reason
+    apart = bias()
+    _size_on_both(apart, 0.06, 0.0002, "CY 3.4°")
+    assert apart.estimate == 0.0317 and "sized_on_both" not in apart.details
+
+
 def test_a_vane_scale_is_read_on_the_axes_the_vane_reaches():
     """sensor_naming.withhold_vane_scale: an α-vane scale reaches the longitudinal axes
     through the model's slopes (C_X, C_Z, C_m agree here on k = 0.087); a C_l mismatch on a

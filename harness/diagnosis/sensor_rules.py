@@ -150,6 +150,9 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
             continue
         k_off, se_off = bias.estimate / x_true, bias.std_error / abs(x_true)
         bias.details["as_scale"] = {"k": k_off, "k_std": se_off, "mean_true": x_true}
+        if bias.selected and _scale_untold(scale, k_off, se_off):
+            _withhold_bias_a_scale_would_make(bias, scale, k_off, se_off, float(np.mean(p.smooth["V"])), p.dt)
+            continue
         if scale is None:
             continue
         shape = scale.details.get("shape")
@@ -179,6 +182,42 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
         bias.selected = False
         bias.details["read_as"] = scale.parameter
         bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
+
+
+def _scale_untold(scale: Candidate | None, k_off: float, se_off: float) -> bool:
+    """Whether the excursions cannot tell a bias from the scale its offset reads as: the scale
+    was not offered (the channel hardly moved, :func:`kinematics.kinematic_check`) or, not
+    named, its reading (:func:`excursion_scale`) lies within two standard errors of both no
+    scale and the offset's ``k_off``."""
+    if scale is None:
+        return True
+    if scale.selected or not scale.std_error > 0:
+        return False
+    k_exc, se_exc = excursion_scale(scale)
+    return abs(k_exc) <= 2.0 * se_exc and abs(k_off - k_exc) <= 2.0 * np.hypot(se_off, se_exc)
+
+
+def _withhold_bias_a_scale_would_make(bias: Candidate, scale: Candidate | None, k_off: float, se_off: float,
+                                      V_mean: float, dt: float) -> None:
+    """Withhold a bias of α or V that a plausible scale factor of the same instrument would make
+    as well (k = b/x̄_true) when the excursions cannot tell the two (:func:`_scale_untold`):
+    a reading (1 + k)·x stands k·x̄ off at the mean, and only the excursions, k times
+    larger, set it apart from a bias. (An independent script's 737 at 18,000 ft and 560 ft/s
+    with a 10 % α-vane scale, doublets at 25 Hz with twice its noise: α moved too little for
+    a scale to be offered, and the offset was named a 0.39° α bias, k = 0.122 ± 0.014 read
+    as a scale.) ``details['scale_rival']`` says what was weighed."""
+    name = f"scale_{bias.channel}"
+    if not (is_plausible(name, k_off, V_mean) and is_practical(name, k_off, dt)):
+        return
+    bias.selected = False
+    exc = None if scale is None else excursion_scale(scale)
+    bias.details["scale_rival"] = {"parameter": name, "offset_k": k_off, "offset_k_std": se_off,
+                                   "excursion_k": None if exc is None else exc[0],
+                                   "excursion_k_std": None if exc is None else exc[1]}
+    told = (f"{bias.channel} moved too little for a scale to be fitted" if exc is None else
+            f"its excursions read k = {exc[0]:.3f} ± {exc[1]:.3f}, within two standard errors of both")
+    bias.reason = (f"entered, but not named: a scale factor of {k_off:.3f} ± {se_off:.3f} ({name}) would make the "
+                   f"same offset at the mean {bias.channel}, and {told}: bias or scale")
 
 
 def excursion_scale(scale: Candidate) -> tuple[float, float]:
