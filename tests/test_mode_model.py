@@ -39,17 +39,38 @@ def test_band_part_keeps_what_lies_in_the_band_only():
 
 
 def test_wiener_surface_leaves_the_motion_and_removes_most_of_the_noise():
-    """A surface that moves below 2 Hz under white sensor noise: its estimate is within the
-    noise of the motion and the noise left above 5 Hz is a small share of the recorded."""
+    """A surface that moves below 2 Hz under white sensor noise: its estimate is nearer the
+    motion than the record, and the noise left above 5 Hz is a small share of the recorded
+    (the cells beside the motion's keep some: their power is averaged over three bins)."""
     rng = np.random.default_rng(3)
     dt = 0.02
     t = np.arange(1500) * dt
     motion = 0.03 * np.sin(2 * np.pi * 0.4 * t) + 0.02 * np.sin(2 * np.pi * 1.3 * t + 1.0)
     noisy = motion + rng.normal(scale=0.001, size=t.size)
     est = wiener_surface(noisy, dt)
-    assert np.std(est - motion) < 0.5 * np.std(noisy - motion)
+    assert np.std(est - motion) < 0.7 * np.std(noisy - motion)
     high = (5.0, 24.0)
-    assert np.std(band_part(est, dt, high)) < 0.2 * np.std(band_part(noisy, dt, high))
+    assert np.std(band_part(est, dt, high)) < 0.4 * np.std(band_part(noisy, dt, high))
+
+
+def test_wiener_surface_keeps_a_steps_content_near_a_mode():
+    """Steps through a 40 rad/s actuator (ζ 0.7) under 0.05° of white noise: between 6 and
+    10 Hz, where an 8 Hz mode rings, the record's noise is 43 % of the step edges' content;
+    the time-varying gain keeps the edges and cuts the noise between them, to within 20 %
+    (a gain set on the whole record's spectrum scaled the edges by about one half)."""
+    from scipy import signal
+    rng = np.random.default_rng(3)
+    dt = 0.02
+    t = np.arange(1500) * dt
+    command = np.zeros_like(t)
+    for a, start, width in ((0.035, 2, 3), (-0.035, 5, 2), (0.035, 7, 1), (-0.035, 8, 1)):
+        command[(t >= start) & (t < start + width)] = a
+    _, surface, _ = signal.lsim(signal.lti([1600.0], [1.0, 56.0, 1600.0]), command, t)
+    noisy = surface + rng.normal(scale=math.radians(0.05), size=t.size)
+    band = (6.0, 10.0)
+    content = np.std(band_part(surface, dt, band))
+    assert np.std(band_part(noisy - surface, dt, band)) > 0.4 * content
+    assert np.std(band_part(wiener_surface(noisy, dt) - surface, dt, band)) < 0.2 * content
 
 
 @pytest.fixture(scope="module")

@@ -26,7 +26,8 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
                                           withhold_even_term_off_the_quiet_flight,
-                                          withhold_explained_by_cg, withhold_explained_by_lift,
+                                          withhold_explained_by_cg, withhold_explained_by_force_arm,
+                                          withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane, withhold_rivals)
 from models.aircraft import Aircraft, has_propeller
@@ -91,6 +92,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # the rules that keep a term from being named when something else would imitate it
     withhold_explained_by_cg(cands, step.selections, mismatch, p)
     withhold_explained_by_lift(cands, step.selections, mismatch, p)
+    withhold_explained_by_force_arm(cands, step.selections, mismatch, p, aero.trim)
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
     withhold_even_term_off_the_quiet_flight(cands, step, p, mismatch)

@@ -318,8 +318,8 @@ AMBIGUOUS_T = cand.AMBIGUOUS_T
 @dataclass(frozen=True)
 class Contest:
     """A selected kinematic term's rival the kinematics cannot rule out: its name, their
-    partial correlation, the term's |t| beside it and, where the rival's own estimate is
-    not the linearised fit's (an exact shift), that estimate and |t|, with why."""
+    partial correlation, the term's |t| beside it, the rival's own estimate and |t| (fitted
+    in the term's place, or as an exact shift) and why, where it is not the correlation."""
 
     rival: str
     correlation: float
@@ -410,11 +410,15 @@ def kinematics_refute(kin: KinematicResult, name: str, k: float, k_std: float) -
             f"kinematics put that scale at {v:.3f} ± {se:.3f} ({z:.1f} standard errors apart)")
 
 
-def kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float, float] | None:
+def kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float, float, tuple | None] | None:
     """The unselected kinematic candidate most collinear with selected ``name`` (partial |r|,
     the forced biases and the other selected terms taken out, at least
-    :data:`rivals.RIVAL_CORRELATION`), with the correlation, ``name``'s |t| beside it and the
-    rival's |t| beside ``name`` (those terms in the fit); None when there is none."""
+    :data:`rivals.RIVAL_CORRELATION`), with the correlation, ``name``'s |t| beside it, the
+    rival's |t| beside ``name`` (those terms in the fit) and the rival's own estimate and |t|
+    in ``name``'s place (None when that fit fails); None when there is none. Beside ``name``
+    the rival's estimate is what the two share out, not its size: an independent script's
+    c172x with a_z 40 ms late had an α scale selected (t 6.8) and the a_z skew beside it at
+    −3 ± 29 ms."""
     cols = kin.columns or {}
     if name not in cols:
         return None
@@ -432,11 +436,17 @@ def kinematic_rival(kin: KinematicResult, name: str) -> tuple[str, float, float,
         theta, se, _ = colored_fit(kin.start, [cols[n] for n in fixed] + [cols[name], cols[best[0]]],
                                    fixed + [name, best[0]], constant=False)
     except (SingularRegressorsError, np.linalg.LinAlgError):
-        return best[0], best[1], 0.0, 0.0
+        return best[0], best[1], 0.0, 0.0, None
     j = len(fixed)
     t_own = float(abs(theta[j] / se[j])) if se[j] > 0 else 0.0
     t_rival = float(abs(theta[j + 1] / se[j + 1])) if se[j + 1] > 0 else 0.0
-    return best[0], best[1], t_own, t_rival
+    try:
+        theta, se, _ = colored_fit(kin.start, [cols[n] for n in fixed] + [cols[best[0]]], fixed + [best[0]],
+                                   constant=False)
+        alone = (float(theta[j]), float(abs(theta[j] / se[j]))) if se[j] > 0 else None
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        alone = None
+    return best[0], best[1], t_own, t_rival, alone
 
 
 def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dict[str, Contest]:
@@ -450,7 +460,7 @@ def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dic
     for n in kin.selection.names:
         found = kinematic_rival(kin, n)
         if found is not None and found[2] < KIN_T_IN and not (found[2] >= AMBIGUOUS_T and found[3] < AMBIGUOUS_T):
-            out[n] = Contest(*found[:3])
+            out[n] = Contest(*found[:3], rival_estimate=found[4])
             continue
         exact = skew_rival(kin, p, n) if p is not None else None
         if exact is not None:

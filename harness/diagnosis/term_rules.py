@@ -108,6 +108,74 @@ def withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatc
                         f"t = {t:.1f}")
 
 
+def reference_arm_ft(trim) -> tuple[float, float]:
+    """The model's aerodynamic reference point from its c.g. in body axes (x forward, z down),
+    ft, from the trim's structural positions (x aft, z up, in)."""
+    return (-(trim.aero_rp_in[0] - trim.cg_in[0]) / 12.0, -(trim.aero_rp_in[2] - trim.cg_in[2]) / 12.0)
+
+
+def moment_of_force_change(delta: dict[str, np.ndarray], arm_ft: tuple[float, float], geometry: dict) -> dict:
+    """The moment coefficients about the c.g. that force-coefficient changes ``delta``
+    (``CX``, ``CY``, ``CZ``) make when they act at a reference point ``arm_ft`` = (x, z) from
+    it (body axes, no y part): r × F, ΔC_l = −z ΔC_Y/b, ΔC_m = (z ΔC_X − x ΔC_Z)/c̄,
+    ΔC_n = x ΔC_Y/b (:mod:`reference_point`)."""
+    x, z = arm_ft
+    cx, cy, cz = (delta.get(k, 0.0) for k in ("CX", "CY", "CZ"))
+    b, c = geometry["b_ft"], geometry["cbar_ft"]
+    return {"Cl": -z * cy / b, "Cm": (z * cx - x * cz) / c, "Cn": x * cy / b}
+
+
+def withhold_explained_by_force_arm(cands: list[Candidate], selections: dict, mismatch: dict[str, np.ndarray],
+                                    p: Prepared, trim) -> None:
+    """A force term named on a model whose aerodynamic reference point is away from its c.g.
+    moves the moments about the c.g. as well: the changed force acts at the reference point
+    (:func:`moment_of_force_change`; a C_Z term read as lift carries its C_X share too,
+    :func:`lift_change_on_cx`). A moment term is kept beside it only if, with that moment
+    removed, it stays significant (|t| >= the entry t) and keeps more than half its change
+    (:data:`IMITATION_SHARE`; the arm is the model's, and a tiny standard error leaves the
+    few per cent a c.g. or arm error puts beside it significant). An independent
+    script's 737 (its reference point as its XML has it, 4.9 ft above and 1.2 ft aft of its
+    loaded c.g.) with C_Y,β −0.25 per rad named C_Y,β −0.254 and, first, C_l,β −0.014: the
+    side force's roll about the c.g., −0.052 ΔC_Y."""
+    named = {axis: [c for c in cands
+                    if c.selected and c.channel == axis and c.test == f"stepwise on the {axis} mismatch"]
+             for axis in ("CX", "CY", "CZ")}
+    arm = reference_arm_ft(trim)
+    if not any(named.values()) or not any(arm):
+        return
+    delta = {}
+    for axis, terms in named.items():
+        if not terms or axis not in selections:
+            continue
+        sel, by_key = selections[axis]
+        keys = [k for k in sel.names if k in by_key and any(by_key[k].parameter == c.parameter for c in terms)]
+        if keys:
+            delta[axis] = sum(sel.params[k] * by_key[k].column for k in keys)
+    if "CZ" in delta:
+        delta["CX"] = delta.get("CX", 0.0) + lift_change_on_cx(delta["CZ"], p.smooth["alpha"])
+    moments = moment_of_force_change(delta, arm, p.meta["geometry"])
+    inner = interior(p)
+    forces = ", ".join(c.parameter for terms in named.values() for c in terms)
+    for axis, moment in moments.items():
+        if axis not in selections or not np.ndim(moment) or not np.any(moment):
+            continue
+        z = mismatch[axis][inner] - moment[inner]
+        sel, by_key = selections[axis]
+        chosen = [k for k in sel.names if k in by_key]
+        for c in cands:
+            key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
+            if not c.selected or c.channel != axis or key is None:
+                continue
+            fit = _refit_term(z, [by_key[k].column[inner] for k in chosen if k != key], by_key[key].column[inner])
+            change = sel.params[key]
+            if fit is None or (abs(fit[1]) >= cand.T_IN and abs(fit[0]) > (1.0 - IMITATION_SHARE) * abs(change)):
+                continue
+            c.selected = False
+            c.reason = (f"entered, but explained by the force change named ({forces}) acting at the model's "
+                        f"aerodynamic reference point, {arm[0]:+.2f} ft forward and {arm[1]:+.2f} ft down of the "
+                        f"c.g.: with its moment removed, {fit[0]:+.3g} (t = {fit[1]:.1f}) of {change:+.3g} is left")
+
+
 def withhold_force_drift_off_the_vane_wander(cands: list[Candidate], step: StepwiseFits, p: Prepared,
                                              mismatch: dict[str, np.ndarray], slope_of, gust, V0: float) -> None:
     """A drift term on a force axis (C_X or C_Z ∝ ΔV/V) must hold beside the α vane's own

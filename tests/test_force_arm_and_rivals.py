@@ -1,0 +1,76 @@
+"""Two rules of the diagnosis that keep one error from being named as another: a force change
+acting at a reference point away from the c.g. moves the moments too
+(term_rules.withhold_explained_by_force_arm), and a kinematic rival is sized in the place of
+the term it contests, not beside it (sensor_rules.kinematic_rival)."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.sensor_rules import kinematic_rival
+from harness.diagnosis.term_rules import (moment_of_force_change, reference_arm_ft,
+                                          withhold_explained_by_force_arm)
+
+
+def test_a_force_at_the_reference_point_moves_the_moments_by_r_cross_f():
+    """r × F with r = (x, 0, z) and F = (C_X, C_Y, C_Z) q̄S: L = −z F_y, M = z F_x − x F_z,
+    N = x F_y, over q̄Sb (q̄Sc̄ for M)."""
+    r = np.array([1.5, 0.0, -4.0])
+    F = np.array([0.02, -0.1, -0.3])
+    L, M, N = np.cross(r, F)
+    got = moment_of_force_change({"CX": F[0], "CY": F[1], "CZ": F[2]}, (r[0], r[2]), {"b_ft": 90.0, "cbar_ft": 12.0})
+    assert got["Cl"] == pytest.approx(L / 90.0) and got["Cm"] == pytest.approx(M / 12.0)
+    assert got["Cn"] == pytest.approx(N / 90.0)
+    # the trim's structural positions (x aft, z up, in): the 737's AERORP 625/24, its c.g. 639/−40
+    trim = SimpleNamespace(aero_rp_in=(625.0, 0.0, 24.0), cg_in=(639.0, 0.0, -40.0))
+    assert reference_arm_ft(trim) == pytest.approx((14.0 / 12.0, -64.0 / 12.0))
+
+
+def _stepwise(axis: str, key: str, parameter: str, column: np.ndarray, change: float):
+    sel = SimpleNamespace(names=(key,), params={key: change})
+    term = SimpleNamespace(column=column, parameter=parameter)
+    cand = Candidate("coefficient_error", "lat", axis, parameter, change, abs(change) / 20, 20.0, 0.1, "1/rad",
+                     f"stepwise on the {axis} mismatch", True, "entered")
+    return (sel, {key: term}), cand
+
+
+def test_a_roll_the_side_force_change_makes_about_the_cg_is_not_a_cl_change():
+    """A C_Y,β change of −0.25 acting 5.3 ft above the c.g. (b 94.7 ft) rolls by +0.056 ΔC_Y:
+    a C_l,β 'change' of −0.014 in the mismatch is its moment and is withheld; a C_l,β change of
+    −0.03 on top of it stays."""
+    rng = np.random.default_rng(1)
+    dt, n = 0.02, 1500
+    t = np.arange(n) * dt
+    beta = 0.02 * np.sin(2 * np.pi * 0.3 * t) + 0.01 * np.sin(2 * np.pi * 0.9 * t)
+    p = SimpleNamespace(n=n, dt=dt, smooth={"alpha": np.full(n, 0.05)},
+                        meta={"geometry": {"b_ft": 94.7, "cbar_ft": 11.0}})
+    trim = SimpleNamespace(aero_rp_in=(625.0, 0.0, 24.0), cg_in=(639.0, 0.0, -40.0))
+    arm = reference_arm_ft(trim)
+    roll = -arm[1] * (-0.25 * beta) / 94.7
+    for extra, kept in ((0.0, False), (-0.03, True)):
+        cy_sel, cy = _stepwise("CY", "beta", "CY_beta", beta, -0.25)
+        cl_sel, cl = _stepwise("Cl", "beta", "Cl_beta", beta, -0.014 + extra)
+        mismatch = {"CY": -0.25 * beta, "Cl": roll + extra * beta + rng.normal(scale=1e-5, size=n)}
+        withhold_explained_by_force_arm([cy, cl], {"CY": cy_sel, "Cl": cl_sel}, mismatch, p, trim)
+        assert cy.selected and cl.selected is kept
+        if not kept:
+            assert "reference point" in cl.reason
+
+
+def test_a_kinematic_rival_is_sized_in_the_place_of_the_term_it_contests():
+    """Two nearly collinear kinematic columns (r ≈ 0.97): the record follows the rival's. Beside
+    the selected term the rival's estimate is whatever the two share out; in its place it is
+    the rival's own size, at a t the contest can use."""
+    rng = np.random.default_rng(2)
+    n = 3000
+    rival = np.sin(np.linspace(0.0, 40.0, n))
+    term = rival + 0.25 * np.sin(np.linspace(0.0, 23.0, n)) + 0.05 * rng.normal(size=n)
+    start = 0.04 * rival + 0.003 * rng.normal(size=n)
+    kin = SimpleNamespace(columns={"scale_alpha": term, "skew_az": rival}, forced=(),
+                          selection=SimpleNamespace(names=("scale_alpha",)), start=start)
+    name, r, t_own, t_rival, alone = kinematic_rival(kin, "scale_alpha")
+    assert name == "skew_az" and abs(r) > 0.9
+    assert alone[0] == pytest.approx(0.04, rel=0.05) and alone[1] > 10.0
