@@ -194,3 +194,17 @@ def test_axis_ratio_reads_the_mismatch_constant_without_the_signature():
     assert r.signature_mean == pytest.approx(float(np.mean(signature)))
     expected = np.linalg.lstsq(np.column_stack([other, np.ones_like(t)]), z, rcond=None)[0][1]
     assert r.mean == pytest.approx(float(expected), abs=1e-12)
+
+
+def test_a_gyro_skews_two_readings_may_differ_by_a_simulation_step():
+    """A rectangular-Euler simulator puts its gyros h/2 ahead of the attitude's difference (the
+    kinematics read a lead) and the rates' difference h/2 behind the moments (the moment
+    mismatch reads a lag): a p skew of 40 ms at 100 Hz read 34 ± 3 ms and 45 ± 1 ms. They
+    agree within one sample interval, which a rate gyro's skew is allowed; not another
+    parameter."""
+    from harness.diagnosis.corroborate import gyro_skew_tolerance
+    ratios = {"Cl": _r(1.32, 0.03)}
+    assert not corroborate("skew_p", 0.0343, 0.0026, ratios, t_aero=5.0).named
+    named = corroborate("skew_p", 0.0343, 0.0026, ratios, t_aero=5.0, tolerance=gyro_skew_tolerance("skew_p", 0.01))
+    assert named.named and 0.04 < named.estimate < 0.046
+    assert gyro_skew_tolerance("skew_alpha", 0.01) == 0.0 and gyro_skew_tolerance("skew_r", 0.02) == 0.02

@@ -173,7 +173,8 @@ def name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: P
     A constant model error on one axis (an asymmetry, a propeller's torque, a thrust or mass
     error, a moment-reference shift) does not match the slopes' proportions on all of them.
     The estimate is kept in ``details['vane_means']`` whether named or not, for the
-    validation maneuver's check."""
+    validation maneuver's check; a bias the kinematics named is sized on both
+    (:func:`_size_on_both`)."""
     name = f"bias_{channel}"
     c = next((c for c in cands if c.parameter == name), None)
     if c is None or name not in kin.parameters:
@@ -209,11 +210,10 @@ def name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: P
 def _size_on_both(c: Candidate, est: float, se: float, each: str) -> None:
     """Size a vane bias the kinematics named on the coefficient means along the vane as well,
     when the two agree within :data:`corroborate.AGREE_Z` standard errors (``each``: the axes'
-    readings): their
-    inverse-variance mean (two independent tests of one constant). The kinematics see a
-    β-vane bias only through cos β and the cross terms: on an independent script's c172x
-    (4,000 ft / 160 ft/s, lateral multisine) a 1° β bias was named at 1.82° ± 0.35° on them;
-    the means read it to ±0.01°."""
+    readings): their inverse-variance mean (two independent tests of one constant). The
+    kinematics see a β-vane bias only through cos β and the cross terms: on an independent
+    script's c172x (4,000 ft / 160 ft/s, lateral multisine) a 1° β bias was named at
+    1.82° ± 0.35° on them; the means read it to ±0.01°."""
     if not (se > 0 and c.std_error > 0) or abs(est - c.estimate) > corroborate.AGREE_Z * np.hypot(se, c.std_error):
         return
     kin_est, kin_se = c.estimate, c.std_error
@@ -246,7 +246,8 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
         v, t = found
         if t < AMBIGUOUS_T or not is_plausible(name, v, V0):
             continue
-        verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
+        verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN,
+                                          tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
         if not _name_if_corroborated(sensor, kin, p, verdict, t):
             continue
         for c in cands:
@@ -274,7 +275,8 @@ def kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, 
             if v == 0.0 or t <= 0:
                 verdicts[name] = None
                 continue
-            verdicts[name] = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN)
+            verdicts[name] = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN,
+                                                     tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
         own, theirs = verdicts[c.parameter], verdicts[rival]
         c.details["kinematic_rival"] = {"parameter": rival, "correlation": r, "t_beside": t_beside,
                                         "own": own.as_dict() if own else None,
@@ -328,8 +330,9 @@ def name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepare
         without = corrected_recording(recorded, kin, {k: x for k, x in applied.items() if k != name})
         base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic, inertial_from=p).mismatch().items()}
         ratios = _axis_ratios(cands, step, inner, base, mismatch)
-        _name_if_corroborated(sensor, kin, p, corroborate.corroborate(name, v, abs(v) / kinematic_t(kin, name), ratios,
-                                                                      t_aero=cand.T_IN), kinematic_t(kin, name))
+        verdict = corroborate.corroborate(name, v, abs(v) / kinematic_t(kin, name), ratios, t_aero=cand.T_IN,
+                                          tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
+        _name_if_corroborated(sensor, kin, p, verdict, kinematic_t(kin, name))
 
 
 def _name_if_corroborated(sensor: Candidate, kin: KinematicResult, p: Prepared, verdict, t_kin: float) -> bool:
