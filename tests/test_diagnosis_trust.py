@@ -826,6 +826,34 @@ def test_a_vane_bias_a_scale_would_make_is_withheld_when_the_excursions_cannot_t
     assert large.selected
 
 
+def test_a_v_scale_named_because_its_bias_was_left_out_is_withheld_when_the_bias_is_plausible():
+    """sensor_rules.withhold_scale_a_bias_would_make: V hardly moves about its mean, so a V
+    bias and scale run to offsetting sizes together and the bias is left out as implausible;
+    the scale named alone (0.05 at 160 ft/s) then reads as a bias of 7.6 ft/s, plausible
+    (under 5 % of V): withheld. A scale whose bias was not left out, or whose offset no
+    plausible bias makes (0.08: 11.9 ft/s, over 5 %), stays named."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.sensor_rules import withhold_scale_a_bias_would_make
+    p = SimpleNamespace(smooth={"V": np.full(100, 160.0), "alpha": np.full(100, 0.05)}, dt=0.02)
+    left_out = SimpleNamespace(dropped={"bias_V": "implausible size in an earlier fit: refitted without it"})
+
+    def scale(k):
+        return Candidate("sensor_scale", None, "V", "scale_V", k, 0.008, k / 0.008, 0.03, "1",
+                         "kinematic consistency", True, "significant, practical and precise")
+    withheld = scale(0.05)
+    withhold_scale_a_bias_would_make([withheld], left_out, p)
+    assert not withheld.selected and "scale or bias" in withheld.reason
+    assert withheld.details["bias_rival"]["offset_bias"] == pytest.approx(0.05 * 160.0 / 1.05)
+    kept = scale(0.05)
+    withhold_scale_a_bias_would_make([kept], SimpleNamespace(dropped={}), p)
+    assert kept.selected
+    large = scale(0.08)
+    withhold_scale_a_bias_would_make([large], left_out, p)
+    assert large.selected
+
+
 def test_a_vane_bias_the_kinematics_name_is_sized_on_the_coefficient_means_too():
     """sensor_naming._size_on_both: the kinematics' 0.0317 ± 0.006 rad and the means'
     0.0178 ± 0.0002 agree within three standard errors: the bias is their inverse-variance

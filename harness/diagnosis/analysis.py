@@ -16,6 +16,7 @@ from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, 
                                              withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
                                             kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
+                                            withhold_scale_a_bias_would_make,
                                             steady_vane, withhold_offset_of_a_scaled_vane)
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
@@ -124,6 +125,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             removed = {c: as_evaluated[c] - mismatch[c] for c in COEFFICIENTS}
             name_applied(cands, kin, recorded, p, aircraft, ic, mismatch, removed, step, sensor_values, V0)
             scale_read_as_bias(cands, recorded)
+            withhold_scale_a_bias_would_make(cands, kin, recorded)
             withhold_offset_of_a_scaled_vane(cands, kin, p, aircraft, ic, as_evaluated, noise, sensor_values)
             withhold_imitated_by_named(cands, imitated, set(sensor_values))
     # 6. spectra and gusts

@@ -184,6 +184,33 @@ def scale_read_as_bias(cands: list[Candidate], p: Prepared) -> None:
         bias.reason = f"read as the offset of {scale.parameter} = {k:.3f} at the mean {channel} (k·x̄)"
 
 
+def withhold_scale_a_bias_would_make(cands: list[Candidate], kin: KinematicResult, p: Prepared) -> None:
+    """Withhold a scale of α or V the kinematics named alone because its bias had been left out
+    of their fit as implausible (:func:`plausible_kinematic_check`: the two, nearly collinear
+    where the channel hardly moves about its mean, had run to offsetting sizes), when that
+    bias, read off the scale's offset k·x̄_true, is a plausible and practical one: the
+    excursions could not tell them apart, and the offset is all either reading rests on.
+    (An independent script's c172x at 4,000 ft and 160 ft/s with a 10 ft/s airspeed bias,
+    a pitch multisine flown through its controls: a V scale of 0.050 ± 0.008 was named, the
+    bias it reads as 8 ft/s.)"""
+    V_mean = float(np.mean(p.smooth["V"]))
+    for channel in OFFSET_SCALE_CHANNELS:
+        scale = next((c for c in cands if c.selected and c.parameter == f"scale_{channel}"), None)
+        dropped = kin.dropped.get(f"bias_{channel}", "")
+        if scale is None or not dropped.startswith("implausible") or channel not in p.smooth:
+            continue
+        k = scale.estimate
+        b = k * float(np.mean(p.smooth[channel])) / (1.0 + k)
+        name = f"bias_{channel}"
+        if not (is_plausible(name, b, V_mean) and is_practical(name, b, p.dt)):
+            continue
+        scale.selected = False
+        scale.details["bias_rival"] = {"parameter": name, "offset_bias": b}
+        scale.reason = (f"entered, but not named: {name} = {b:.3g} would make the same offset at the mean "
+                        f"{channel}, and the kinematics could not fit the two together ({name} {dropped}): "
+                        "scale or bias")
+
+
 def _scale_untold(scale: Candidate | None, k_off: float, se_off: float) -> bool:
     """Whether the excursions cannot tell a bias from the scale its offset reads as: the scale
     was not offered (the channel hardly moved, :func:`kinematics.kinematic_check`) or, not
