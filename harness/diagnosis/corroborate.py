@@ -17,13 +17,18 @@ seed Eq. 39) gives ``a_C ± σ_C``. The error is named when
 
 * the axes that can tell (``σ_C`` at most :data:`INFORMATIVE_SE`) agree with one ratio
   ``â`` (each within :data:`AGREE_Z` of its standard errors, or :data:`AGREE_FRACTION`),
-  which a single coefficient error cannot do: a wrong C_Z,α moves C_Z alone, a wrong α
-  vane moves C_Z, C_m and C_X by the model's own slopes;
+  which a single coefficient error hardly does: a wrong C_Z,α moves C_Z alone, a wrong α
+  vane moves C_Z, C_m and C_X by the model's own slopes (a change of lift moves C_X with C_Z
+  nearly in the vane's proportion, and C_m through the reference point's arm: the mistrim
+  below tells them apart);
 * the aerodynamic evidence is significant on its own (``â/σ_â`` at least the aerodynamic
   entry t; σ_â allowing for the axes' estimates' correlation, :func:`estimate_correlation`:
   every axis carries the model's slope times the same vane wander);
 * it agrees with the kinematic estimate (``|â - 1|`` within :data:`AGREE_Z` of the
-  combined standard error).
+  combined standard error, and for a rate gyro's skew one sample interval more:
+  :func:`gyro_skew_tolerance`);
+* the mismatch carries the mistrim a scale error makes at trim, which the ratios (fitted
+  with a constant) leave out (:func:`mistrim_test`).
 
 The size named is the inverse-variance mean of the two estimates.
 """
@@ -283,8 +288,7 @@ def mistrim_test(axes: tuple[AxisRatio, ...], ratio: float, ratio_std: float) ->
     +0.6 per rad about the trim α (8,000 ft / 400 ft/s, doublets, twice the noise) had an α
     scale of −0.078 named by the kinematics (t 4.3; −0.057 at t 3.6 on the same noise without
     the lift change) and C_X, C_Z, C_m: its C_Z mistrim of −0.028 was missing (+0.002 ± 0.002).
-    A bias's or a skew's signature has no mean of its own to test (fitted without a constant,
-    or none)."""
+    A bias's signature is fitted without a constant, so there is no mean of its own to test."""
     for a in axes:
         if not (np.isfinite(a.mean) and np.isfinite(a.signature_mean)):
             continue
