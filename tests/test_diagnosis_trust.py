@@ -187,6 +187,28 @@ def test_a_term_that_fails_its_entry_rules_at_the_calibrated_size_is_withdrawn()
         "reason"]
 
 
+def test_a_term_the_calibration_puts_far_under_its_entry_is_withdrawn():
+    """augmented.unsupported_in_the_loop: a C_Z,α change of +1.44 ± 0.26 by equation error (the
+    vanes' noise on a 737 record) that the calibration sizes at +0.195 ± 0.02 — 4.8 of the
+    equation error's standard errors under it, and at t 0.75 on them — is withdrawn; one the
+    calibration puts at 1.2 (under the equation error's size by less than 3 of its standard
+    errors) stands."""
+    from harness.diagnosis.augmented import unsupported_in_the_loop
+    from harness.diagnosis.evidence import Candidate
+
+    def cand():
+        return Candidate("coefficient_error", "lon", "CZ", "CZ_alpha", -2.93, 0.26, 5.5, 0.35, "per rad",
+                         "stepwise on the CZ mismatch", selected=True, reason="entered",
+                         details={"change": 1.44, "excursion_share": 0.4})
+    far, near = cand(), cand()
+    checks: dict = {}
+    assert unsupported_in_the_loop([far], {"used": True, "findings": {"CZ_alpha": {"size": 0.195, "std_error": 0.02}}},
+                                   checks) == [far]
+    assert "would not have entered" in checks[id(far)]["reason"]
+    assert unsupported_in_the_loop([near], {"used": True, "findings": {"CZ_alpha": {"size": 1.2, "std_error": 0.02}}},
+                                   checks) == []
+
+
 def test_a_term_the_calibration_sizes_with_the_other_sign_is_withdrawn():
     """augmented.unsupported_in_the_loop: a coefficient change the equation error puts at +0.96
     and the calibration, clearly away from zero, at −0.16 ± 0.02 (an α-vane scale read as a
