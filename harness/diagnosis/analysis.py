@@ -16,8 +16,8 @@ from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, 
                                              withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
                                             kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
-                                            withhold_scale_a_bias_would_make,
-                                            steady_vane, withhold_offset_of_a_scaled_vane)
+                                            steady_vane, withhold_offset_of_a_scaled_vane,
+                                            withhold_scale_a_bias_would_make)
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns, withhold_on_moving_throttle,

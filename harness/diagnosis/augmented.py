@@ -339,12 +339,12 @@ def unsupported_in_the_loop(findings: list[Candidate], calibration: dict, checks
     less than :data:`term_rules.IMITATION_SHARE` of it, and where the equation error's size lies
     more than :data:`CALIBRATED_MIN_Z` of its standard errors from the calibrated one, the
     calibrated size must still reach the entry t on the equation error's standard error (an
-    independent script's 737 at 28,000 ft / 700 ft/s, a pitch multisine with twice its noise:
-    a C_Z,α change of +1.44 ± 0.26 by equation error, drawn by the vanes' noise, calibrated to
-    +0.195 and confirmed by chance on the validation maneuver). Noise-free three-axis recordings of the
-    package's c182 and pa28, flown by an independent script, had named a C_m,δe change the
-    calibration put at −0.0064 (equation error −0.022: 1 % of the model's −0.59) and a C_m,α̇
-    of 0.50 (equation error 1.73) that JSBSim's Euler half-step imitates up to 0.39."""
+    independent script's 737 at 28,000 ft / 700 ft/s, a pitch multisine with twice its noise: a
+    C_Z,α change of +1.44 ± 0.26 by equation error, drawn by the vanes' noise, calibrated to
+    +0.195 and confirmed by chance on the validation maneuver). Noise-free three-axis recordings
+    of the package's c182 and pa28, flown by an independent script, had named a C_m,δe change
+    the calibration put at −0.0064 (equation error −0.022: 1 % of the model's −0.59) and a
+    C_m,α̇ of 0.50 (equation error 1.73) that JSBSim's Euler half-step imitates up to 0.39."""
     if not calibration.get("used"):
         return []
     sized = calibration.get("findings") or {}

@@ -103,10 +103,11 @@ def mode_responses(u: np.ndarray, dt: float, frequency_hz: float, damping: float
 def white_noise_std(x: np.ndarray) -> float:
     """The standard deviation of a record's white noise from its fourth differences: robustly
     (median absolute deviation over that of a unit normal, ``MAD_TO_SIGMA``), and with their
-    variance 70 σ² for white noise (the sum of the squared binomial coefficients, C(8, 4)). A fourth difference passes a
-    2 Hz motion at 50 samples/s at 0.4 % of its amplitude and puts a step's edge into four
-    samples only, so neither the maneuver's motion nor the sharp edges of a step input (whose
-    spectrum can stand above the noise up to Nyquist) are counted as noise."""
+    variance 70 σ² for white noise (the sum of the squared binomial coefficients, C(8, 4)). A
+    fourth difference passes a 2 Hz motion at 50 samples/s at 0.4 % of its amplitude and puts a
+    step's edge into four samples only, so neither the maneuver's motion nor the sharp edges of
+    a step input (whose spectrum can stand above the noise up to Nyquist) are counted as
+    noise."""
     d = np.diff(np.asarray(x, dtype=float), 4)
     return float(np.median(np.abs(d - np.median(d))) / MAD_TO_SIGMA / np.sqrt(70.0))
 
@@ -119,16 +120,16 @@ def wiener_surface(u: np.ndarray, dt: float, segment_s: float = SEGMENT_S) -> np
     1979), P the cell's power averaged over :data:`WIENER_BINS` neighbouring frequencies (its
     scatter would otherwise pass a share of the noise), N the white sensor noise's power per
     cell (:func:`white_noise_std`; σ² Σw²/(Σw)² for scipy.signal.stft's scaling), subtracted
-    :data:`OVERSUBTRACTION` times over. A mode's
-    resonance rings the sensor noise of a surface as loudly as its motion near the mode
-    (0.05° of potentiometer noise on a 2° doublet, an 8 Hz mode at ζ 0.02), so the response is
-    built on an estimate, not on the raw record (fitted on it, the gains of a gallery mode come
-    out within 15 %, ``tests/test_mode_model.py``). A step through an actuator holds its content near the mode only
-    for a few tenths of a second after each edge: a gain set on the whole record's spectrum
-    (tried first) scaled those edges by the record's average signal share, about one half on
-    the outside sweep's 8 Hz F-16 mode, and the validation maneuver's ringing was predicted
-    at half its size (q's band 54 % explained); set per cell it keeps the edges and removes
-    the noise between them (91 %, :data:`OVERSUBTRACTION`)."""
+    :data:`OVERSUBTRACTION` times over. A mode's resonance rings the sensor noise of a surface
+    as loudly as its motion near the mode (0.05° of potentiometer noise on a 2° doublet, an 8 Hz
+    mode at ζ 0.02), so the response is built on an estimate, not on the raw record (fitted on
+    it, the gains of a gallery mode come out within 15 %, ``tests/test_mode_model.py``). A step
+    through an actuator holds its content near the mode only for a few tenths of a second after
+    each edge: a gain set on the whole record's spectrum (tried first) scaled those edges by the
+    record's average signal share, about one half on the outside sweep's 8 Hz F-16 mode, and the
+    validation maneuver's ringing was predicted at half its size (q's band 54 % explained); set
+    per cell it keeps the edges and removes the noise between them (91 %,
+    :data:`OVERSUBTRACTION`)."""
     x = np.asarray(u, dtype=float)
     m = float(np.mean(x))
     nper = max(8, min(int(round(segment_s / dt)), x.size))
