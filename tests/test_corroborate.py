@@ -208,3 +208,39 @@ def test_a_gyro_skews_two_readings_may_differ_by_a_simulation_step():
     named = corroborate("skew_p", 0.0343, 0.0026, ratios, t_aero=5.0, tolerance=gyro_skew_tolerance("skew_p", 0.01))
     assert named.named and 0.04 < named.estimate < 0.046
     assert gyro_skew_tolerance("skew_alpha", 0.01) == 0.0 and gyro_skew_tolerance("skew_r", 0.02) == 0.02
+
+
+def test_the_offered_term_most_collinear_with_the_signature_beside_the_others():
+    """axis_ratio keeps the axis's own candidate column most correlated with the signature once
+    both are made orthogonal to the named terms and a constant (exact on constructed data),
+    and the share the fitted signature makes of the coefficient's excursion."""
+    t = np.linspace(0.0, 10.0, 501)
+    other = np.cos(0.7 * t)
+    rate = np.sin(1.3 * t)
+    signature = 2.0 * rate + 0.5 * other + 0.1  # the named term and a constant explain the rest
+    z = 0.4 * other - 0.8 * signature
+    offered = {"Cl_phat": rate + 3.0 * other, "Cl_da": np.sin(2.9 * t) + 0.01 * rate}
+    r = axis_ratio(z, [other], signature, offered=offered, excursion=float(np.std(z)) * 10)
+    assert r.imitator == "Cl_phat" and r.imitator_r == pytest.approx(1.0, abs=1e-9)
+    assert r.share == pytest.approx(0.8 * np.std(signature) / (10 * np.std(z)))
+    assert axis_ratio(z, [other], signature).imitator == ""
+
+
+def test_one_axis_a_term_of_its_own_imitates_is_no_second_test():
+    """corroborate.imitated_on_one_axis: the Global 5000 null's V scale (kinematic −0.059 ±
+    0.017) shown by C_l alone (0.71 ± 0.13, collinear with C_l,p̂ at r 0.988, a share of
+    0.026) is not named; the same axis making a practical share (an a_z skew's C_Z, 0.097), a
+    signature no term imitates, or two axes showing it, are."""
+    from harness.diagnosis.corroborate import IMITATOR_R, imitated_on_one_axis
+    from harness.diagnosis.candidates import PRACTICAL_SHARE
+
+    def ax(name, ratio, se, r, share):
+        return AxisRatio(name, ratio, se, imitator="term", imitator_r=r, share=share)
+    weak_cm = ax("Cm", 0.39, 0.41, 0.67, 0.007)
+    v = corroborate("scale_V", -0.059, 0.0176, {"Cl": ax("Cl", 0.71, 0.126, 0.988, 0.026), "Cm": weak_cm},
+                    t_aero=5.0)
+    assert not v.named and "only Cl shows it" in v.reason
+    assert imitated_on_one_axis((ax("CZ", 1.24, 0.17, 0.974, 0.097),)) == ""
+    assert imitated_on_one_axis((ax("Cl", 0.71, 0.126, IMITATOR_R - 0.01, 0.026),)) == ""
+    assert imitated_on_one_axis((ax("Cl", 0.71, 0.126, 0.99, PRACTICAL_SHARE),)) == ""
+    assert imitated_on_one_axis((ax("Cl", 1.0, 0.2, 1.0, 0.01), ax("Cn", 1.0, 0.2, 1.0, 0.01))) == ""

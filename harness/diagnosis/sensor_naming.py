@@ -45,23 +45,29 @@ def signature_ratios(cands: list[Candidate], kin: KinematicResult, p: Prepared, 
             # a β-vane error cannot reach a mismatch along the inertial sideslip: its signature
             # is taken along the vane (whose slow wander the colored-residual fit allows for)
             changed = model_along(corrected_recording(p, kin, {name: value}), aircraft, ic, vane_beta=True).mismatch()
-            return _axis_ratios(cands, step, inner, along_vane(), changed, skip, constant)
+            return _axis_ratios(cands, step, inner, along_vane(), changed, skip, constant, p)
         changed = model_along(corrected_recording(p, kin, {name: value}), aircraft, ic, inertial_from=p).mismatch()
-        return _axis_ratios(cands, step, inner, mismatch, changed, skip, constant)
+        return _axis_ratios(cands, step, inner, mismatch, changed, skip, constant, p)
     return ratios
 
 
 def _axis_ratios(cands: list[Candidate], step: StepwiseFits, inner: slice, base: dict[str, np.ndarray],
-                 changed: dict[str, np.ndarray], skip: frozenset[str] = frozenset(), constant: bool = True) -> dict:
+                 changed: dict[str, np.ndarray], skip: frozenset[str] = frozenset(), constant: bool = True,
+                 p: Prepared | None = None) -> dict:
     """Per axis, :func:`corroborate.axis_ratio` of ``base`` on the change ``changed - base``,
     beside the axis's named terms (those in ``skip`` left out) and its nuisance columns (with
-    a constant unless not ``constant``)."""
+    a constant unless not ``constant``); the axis's other candidate terms are offered as the
+    signature's imitators, and ``p``'s measured coefficients give its share."""
     out = {}
     for axis, (sel, by_key) in step.selections.items():
         kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
         others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
         others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
-        r = corroborate.axis_ratio(base[axis][inner], others, (changed[axis] - base[axis])[inner], constant)
+        offered = {t.parameter: t.column[inner] for k, t in by_key.items()
+                   if t.parameter not in kept and np.ptp(t.column[inner]) > 0}
+        excursion = float(np.std(p.measured[axis][inner])) if p is not None and axis in p.measured else np.nan
+        r = corroborate.axis_ratio(base[axis][inner], others, (changed[axis] - base[axis])[inner], constant, offered,
+                                   excursion)
         if r is not None:
             out[axis] = r
     return out
@@ -182,7 +188,7 @@ def name_vane_bias_from_means(cands: list[Candidate], kin: KinematicResult, p: P
     by_kinematics = c.selected
     base = model_along(p, aircraft, ic, vanes=True).mismatch()
     changed = model_along(corrected_recording(p, kin, {name: PROBE_VANE_BIAS}), aircraft, ic, vanes=True).mismatch()
-    ratios = {k: r for k, r in _axis_ratios(cands, step, interior(p), base, changed, constant=False).items()
+    ratios = {k: r for k, r in _axis_ratios(cands, step, interior(p), base, changed, constant=False, p=p).items()
               if k in VANE_MEANS_AXES[channel]}
     ag = corroborate.imitates(ratios, t_aero=cand.T_IN)
     if ag is None:
@@ -329,7 +335,7 @@ def name_applied(cands: list[Candidate], kin: KinematicResult, recorded: Prepare
             continue
         without = corrected_recording(recorded, kin, {k: x for k, x in applied.items() if k != name})
         base = {c: x - removed[c] for c, x in model_along(without, aircraft, ic, inertial_from=p).mismatch().items()}
-        ratios = _axis_ratios(cands, step, inner, base, mismatch)
+        ratios = _axis_ratios(cands, step, inner, base, mismatch, p=p)
         verdict = corroborate.corroborate(name, v, abs(v) / kinematic_t(kin, name), ratios, t_aero=cand.T_IN,
                                           tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
         _name_if_corroborated(sensor, kin, p, verdict, kinematic_t(kin, name))
