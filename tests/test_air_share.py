@@ -73,3 +73,22 @@ def test_turbulence_stands_only_if_the_aerodynamics_followed_the_vanes():
     assert gust_verdict(gust, vane, False, "", 330.0, "gusts near") == (False, False, "")
     assert gust_verdict(gust, undecided, False, "", 330.0, "gusts near") == (False, False, "")
     assert gust_verdict(gust, None, True, "", 700.0) == (True, False, "")
+
+
+def test_turbulence_the_air_share_does_not_affirm_is_not_named_and_voids_the_terms():
+    """gust_rules.spectral_candidates: a gust level the air-share test neither affirms nor
+    refutes (an independent script's 787-8 null, a 0.2° β-vane wander at 770 ft/s read as a
+    3.04 ft/s gust, C_Z's air share 0.97 ± 0.27) stays turbulent for the rules that void the
+    terms, but is not named; an affirmed share (1.30 ± 0.21, the outside sweep's lateral
+    severity-3 case at 700 ft/s) is."""
+    from harness.diagnosis.gust_rules import affirms_air, spectral_candidates
+    gust = SimpleNamespace(sigma_w_fps=2.18, sigma_v_fps=3.04, ratio_to_noise=35.7)
+    undecided = AirShare(0.97, 0.27, np.radians(0.16))
+    assert gust_verdict(gust, undecided, True, "", 770.0) == (True, False, "")
+    (c,) = spectral_candidates(None, gust, True, False, undecided)
+    assert not affirms_air(undecided) and not c.selected and c.details["air_unaffirmed"]
+    assert c.reason.startswith("not named") and "0.97 ± 0.27" in c.reason
+    affirmed = AirShare(1.30, 0.21, np.radians(0.2))
+    (c,) = spectral_candidates(None, gust, True, False, affirmed)
+    assert affirms_air(affirmed) and c.selected and c.estimate == pytest.approx(3.04)
+    assert not affirms_air(None)

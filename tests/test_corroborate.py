@@ -226,12 +226,13 @@ def test_the_offered_term_most_collinear_with_the_signature_beside_the_others():
     assert axis_ratio(z, [other], signature).imitator == ""
 
 
-def test_one_axis_a_term_of_its_own_imitates_is_no_second_test():
-    """corroborate.imitated_on_one_axis: the Global 5000 null's V scale (kinematic −0.059 ±
+def test_axes_their_own_terms_imitate_are_no_second_test():
+    """corroborate.imitated_by_own_terms: the Global 5000 null's V scale (kinematic −0.059 ±
     0.017) shown by C_l alone (0.71 ± 0.13, collinear with C_l,p̂ at r 0.988, a share of
-    0.026) is not named; the same axis making a practical share (an a_z skew's C_Z, 0.097), a
-    signature no term imitates, or two axes showing it, are."""
-    from harness.diagnosis.corroborate import IMITATOR_R, imitated_on_one_axis
+    0.026) is not named, nor one C_l and C_m show only as small rate-derivative changes; an
+    axis making a practical share (an a_z skew's C_Z, 0.097) or a signature no term imitates
+    tells it."""
+    from harness.diagnosis.corroborate import IMITATOR_R, imitated_by_own_terms
     from harness.diagnosis.candidates import PRACTICAL_SHARE
 
     def ax(name, ratio, se, r, share):
@@ -239,8 +240,10 @@ def test_one_axis_a_term_of_its_own_imitates_is_no_second_test():
     weak_cm = ax("Cm", 0.39, 0.41, 0.67, 0.007)
     v = corroborate("scale_V", -0.059, 0.0176, {"Cl": ax("Cl", 0.71, 0.126, 0.988, 0.026), "Cm": weak_cm},
                     t_aero=5.0)
-    assert not v.named and "only Cl shows it" in v.reason
-    assert imitated_on_one_axis((ax("CZ", 1.24, 0.17, 0.974, 0.097),)) == ""
-    assert imitated_on_one_axis((ax("Cl", 0.71, 0.126, IMITATOR_R - 0.01, 0.026),)) == ""
-    assert imitated_on_one_axis((ax("Cl", 0.71, 0.126, 0.99, PRACTICAL_SHARE),)) == ""
-    assert imitated_on_one_axis((ax("Cl", 1.0, 0.2, 1.0, 0.01), ax("Cn", 1.0, 0.2, 1.0, 0.01))) == ""
+    assert not v.named and "Cl as a change of term (r = 0.988" in v.reason
+    assert imitated_by_own_terms((ax("CZ", 1.24, 0.17, 0.974, 0.097),)) == ""
+    assert imitated_by_own_terms((ax("Cl", 0.71, 0.126, IMITATOR_R - 0.01, 0.026),)) == ""
+    assert imitated_by_own_terms((ax("Cl", 0.71, 0.126, 0.99, PRACTICAL_SHARE),)) == ""
+    # two axes, each as a small change of its own rate derivative (an F-16's V scale, kinematic t 3.2)
+    assert imitated_by_own_terms((ax("Cl", 1.64, 0.41, 0.998, 0.025), ax("Cm", 1.46, 0.43, 0.99999, 0.012))) != ""
+    assert imitated_by_own_terms((ax("Cl", 1.0, 0.2, 1.0, 0.09), ax("Cn", 1.0, 0.2, 1.0, 0.01))) == ""

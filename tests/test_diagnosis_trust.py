@@ -362,7 +362,7 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
     from harness.diagnosis.evidence import Candidate
     from harness.diagnosis.replication import name_replicated
     monkeypatch.setattr(replication, "_kinematics_trusted", lambda a: True)
-    monkeypatch.setattr(replication, "kinematic_rival", lambda kin, name: None)
+    monkeypatch.setattr(replication, "kinematic_rival", lambda kin, name, gate=None: None)
     monkeypatch.setattr(replication, "sensor_verdict", lambda *args: (True, ""))
 
     def analysis(v, se):

@@ -358,3 +358,22 @@ def test_an_f16_flown_with_its_fcs_on_is_evaluated_with_the_fcs_s_surfaces(tmp_p
     off = fly(tmp_path / "off.csv", "f16", 10_000.0, 427.4, 537, 50.0, "ms3", noise=1.0, amplitude_deg=2.0)
     res = diagnose("f16", off, tmp_path / "d_off", None, calibrate=False)
     assert next(a for a in res["assumptions"] if a["item"] == "other control surfaces")["choice"] == "held"
+
+
+def test_a_late_roll_gyro_is_named_not_a_bank_skew_and_aileron_delay(tmp_path):
+    """The package's OV-10 (8,000 ft / 385 ft/s, three-axis multisine at 100 Hz) with p 40 ms
+    late: the kinematics selected a φ skew (−41 ms, t 8.3) beside which the p skew (partial
+    r 0.81) left it t 1.8 — a rival now (sensor_rules.KINEMATIC_RIVAL_CORRELATION) that the
+    C_l mismatch decides for p — and the delay scan read the late rolling moment as an
+    aileron delay of 44 ms, which the p skew imitates
+    (sensor_naming.withhold_delays_imitated_by_named)."""
+    import jsbsim
+    model = str(Path(jsbsim.get_default_root_dir()) / "aircraft" / "OV10" / "OV10.xml")
+    import independent_script
+    independent_script.SURFACE_PROPERTIES.setdefault(
+        "OV10", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    rec = fly(tmp_path / "ms3.csv", "OV10", 8000.0, 385.0, 109, 100.0, "ms3", amplitude_deg=2.0)
+    _sensor_error(rec, "p_rps", lambda t, x: np.interp(t - 0.04, t, x))
+    result = diagnose(model, rec, tmp_path / "out", calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["skew_p"] and found[0][1] == pytest.approx(0.04, abs=0.006)

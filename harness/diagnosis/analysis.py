@@ -12,7 +12,8 @@ from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_tes
 from harness.diagnosis.gusts import process_noise_model
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, name_applied, name_corroborated,
-                                             name_vane_bias_from_means, signature_ratios, withhold_imitated_by_named,
+                                             name_vane_bias_from_means, signature_ratios,
+                                             withhold_delays_imitated_by_named, withhold_imitated_by_named,
                                              withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
                                             kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
@@ -128,6 +129,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             withhold_scale_a_bias_would_make(cands, kin, recorded)
             withhold_offset_of_a_scaled_vane(cands, kin, p, aircraft, ic, as_evaluated, noise, sensor_values)
             withhold_imitated_by_named(cands, imitated, set(sensor_values))
+            withhold_delays_imitated_by_named(cands, kin, p, aircraft, ic, aero.derivatives, noise, set(sensor_values))
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += spectral_candidates(peak, gust, turbulent, light, air)

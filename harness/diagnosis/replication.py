@@ -10,8 +10,9 @@ import numpy as np
 
 from harness.diagnosis import corroborate
 from harness.diagnosis.evidence import Analysis, Candidate
-from harness.diagnosis.gust_rules import mode_candidate
+from harness.diagnosis.gust_rules import mode_candidate, voids_kinematics
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+from harness.diagnosis.rivals import RIVAL_CORRELATION
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, kinematic_rival, kinematics_plausible, sensor_verdict,
                                             suspected_estimate)
 from harness.diagnosis.spectra import FISHER_P, MODE_CONFIRM_P, peak_at, predicted_peak_p, untestable_at
@@ -32,7 +33,9 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
     flew both, and their kinematic residuals carry independent noise. Not when either record's
     kinematics are void (turbulence, light gusts, implausible estimates), when the
     identification's kinematics cannot tell the parameter from a rival
-    (:func:`kinematic_rival`), or when the combined size is not practical and precise
+    (:func:`kinematic_rival` at the seed's pairwise limit, :data:`rivals.RIVAL_CORRELATION`:
+    the project sweep's a_z bias of 0.025 g, t 4.7 and 6.3 on the two maneuvers, has a rival at
+    r between 0.7 and 0.9), or when the combined size is not practical and precise
     (:func:`sensor_verdict`). Returns the candidates of ``a`` it selected.
 
     Biases only, and only when no other sensor error is named: the replication shows the two
@@ -59,7 +62,7 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
         if abs(c.estimate - v.estimate) > 2.0 * np.hypot(c.std_error, v.std_error):
             continue
         est, se = corroborate.inverse_variance_mean([c.estimate, v.estimate], [c.std_error, v.std_error])
-        if abs(est) / se < KIN_T_IN or kinematic_rival(kin, c.parameter) is not None:
+        if abs(est) / se < KIN_T_IN or kinematic_rival(kin, c.parameter, RIVAL_CORRELATION) is not None:
             continue
         if not sensor_verdict(c.parameter, est, se, True, kin, p, False, True)[0]:
             continue
@@ -128,7 +131,7 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
 def _kinematics_trusted(a: Analysis) -> bool:
     """Whether a recording's kinematic consistency can judge its sensors: no turbulence
     named, no light gusts (:func:`light_gusts`), every supported estimate plausible."""
-    turbulent = any(c.effect == "turbulence" and c.selected for c in a.candidates)
+    turbulent = voids_kinematics(a.candidates)
     V0 = float(np.mean(a.prepared.smooth["V"]))
     return not turbulent and not a.gusty and kinematics_plausible(a.kinematic, V0, a.prepared)
 

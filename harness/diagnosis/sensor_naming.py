@@ -16,6 +16,7 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
+                                            unit_members,
                                             kinematics_refute, sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
 from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel, term_change
@@ -381,3 +382,36 @@ def withhold_imitated_by_named(cands: list[Candidate], imitated, applied: set[st
             c.details["sensor_rival"] = sensor.parameter
             c.reason = (f"entered, but not named: the {sensor.parameter} named ({sensor.estimate:.3g} ± "
                         f"{sensor.std_error:.2g} {sensor.units}) imitates {size:.2g} of this change of {change:.3g}")
+
+
+def withhold_delays_imitated_by_named(cands: list[Candidate], kin: KinematicResult, p: Prepared, aircraft: Aircraft,
+                                      ic: InitialCondition, derivatives: dict[str, float], noise: dict[str, float],
+                                      applied: set[str]) -> None:
+    """Deselect a control delay that a sensor error named (and not applied to the channels,
+    ``applied``) imitates: the delay scan (:func:`candidates.delay_scan`, ``derivatives`` the
+    model's control derivatives) made again on the mismatch of the channels corrected by the
+    error's named size finds a delay shorter by :data:`term_rules.IMITATION_SHARE` of it or
+    more. A rate gyro's lag moves the measured moment (built from its derivative) late
+    against the surfaces, as a surface delay does: an independent script's OV-10 (8,000 ft /
+    385 ft/s, three-axis multisine at 100 Hz) with p 40 ms late named the p skew (40 ms) and
+    an aileron delay of 44 ms (t 92) beside it. The time skew the kinematics show is
+    preferred over the coefficient change it imitates."""
+    named = [c for c in cands if c.selected and c.effect in SENSOR_EFFECTS and c.parameter not in applied]
+    delays = [c for c in cands if c.selected and c.effect == "control_delay"]
+    for sensor in named:
+        if not delays:
+            return
+        members = unit_members(kin, sensor.parameter)
+        corrected = corrected_recording(p, kin, {m: sensor.estimate for m in members})
+        mismatch = model_along(corrected, aircraft, ic, inertial_from=p).mismatch()
+        for c in list(delays):
+            scan = cand.delay_scan(corrected, c.channel, mismatch, derivatives, noise)
+            after = scan.tau_s if scan is not None else 0.0
+            if c.estimate - after < IMITATION_SHARE * c.estimate:
+                continue
+            delays.remove(c)
+            c.selected = False
+            c.details["sensor_rival"] = sensor.parameter
+            c.reason = (f"entered, but not named: the {sensor.parameter} named ({sensor.estimate:.3g} ± "
+                        f"{sensor.std_error:.2g} {sensor.units}) imitates it: with the channels corrected for it the "
+                        f"delay scan finds {1e3 * after:.0f} ms, not {1e3 * c.estimate:.0f} ms")

@@ -8,7 +8,7 @@ import numpy as np
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import interior
 from harness.diagnosis.evidence import Analysis, Candidate
-from harness.diagnosis.gust_rules import NOT_IN_GUSTS, NOT_IN_TURBULENCE, vane_wander
+from harness.diagnosis.gust_rules import NOT_IN_GUSTS, NOT_IN_TURBULENCE, vane_wander, voids_kinematics
 from harness.diagnosis.kinematics import time_base_problem
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared, throttle_travel, undriven_reason
 from harness.diagnosis.sensor_naming import MEANS_TESTS
@@ -448,9 +448,10 @@ def in_turbulence(a: Analysis) -> list[dict]:
     to the coefficient mismatch (the gust's rotational part is an unmeasured regressor), each
     listing the parameters that passed every other rule and were withheld for it, so that an
     error under the gusts is not silently dropped (probe 59: a q-gyro bias of 0.5 deg/s under
-    Dryden severity 3 estimated at 0.0089 ± 0.0004 rad/s, t 25, beside the turbulence named)."""
-    named = any(c.effect == "turbulence" and c.selected for c in a.candidates)
-    if not named or a.gusty:
+    Dryden severity 3 estimated at 0.0089 ± 0.0004 rad/s, t 25, beside the turbulence named).
+    Gusts the air-share test did not affirm (``details['air_unaffirmed']``,
+    :func:`gust_rules.spectral_candidates`) leave the same untested, unnamed."""
+    if not voids_kinematics(a.candidates) or a.gusty:
         return []
     terms = sorted({c.effect for c in a.candidates if c.reason == NOT_IN_GUSTS} | {"coefficient_error"})
     return ([_withheld(a.candidates, e, NOT_IN_TURBULENCE, IN_TURBULENCE, "those listed passed every other rule")
