@@ -23,12 +23,15 @@ class FlightCondition:
         True airspeed, ft/s.
     note : str
         Why this point was chosen.
+    bank_deg : float
+        A steady coordinated turn at this bank angle (deg); 0, wings level.
     """
 
     name: str
     h_ft: float
     V_fps: float
     note: str = ""
+    bank_deg: float = 0.0
 
 
 # F-16 at the seed's condition (10,000 ft, alpha near 5 deg), clean (gear up: models.configuration).

@@ -32,14 +32,25 @@ def start_samples(t: np.ndarray, window_s: float = START_WINDOW_S) -> int:
 
 @dataclass(frozen=True)
 class InitialCondition:
-    """Where the recording starts: the model is trimmed wings-level here."""
+    """Where the recording starts: the model is trimmed here, wings level, or in a steady
+    coordinated turn at the recording's bank when that is :data:`TURN_BANK_MIN_DEG` or more."""
 
     h_ft: float
     V_fps: float
     alpha_rad: float = 0.0  # the recording's own α at the start (a reference, not imposed)
+    phi_rad: float = 0.0    # the recording's bank at the start
 
     def condition(self) -> FlightCondition:
-        return FlightCondition("recording", self.h_ft, self.V_fps, "the recording's initial condition")
+        bank = math.degrees(self.phi_rad)
+        return FlightCondition("recording", self.h_ft, self.V_fps, "the recording's initial condition",
+                               bank_deg=bank if abs(bank) >= TURN_BANK_MIN_DEG else 0.0)
+
+
+# A recording that starts banked this much (deg) or more is taken to start in a steady turn,
+# where the model is trimmed (models.trim): an engine trimmed wings level gives a banked
+# record's propeller too little power (a J-3 Cub at 45°, 99 ft/s, needs n = 1.41), and the
+# slipstream over its tail reads as a control-derivative change (its C_n,δr off by 8 %).
+TURN_BANK_MIN_DEG = 5.0
 
 
 def _instance(aircraft: Aircraft, ic: InitialCondition, refs: Mapping[str, float] | None):
@@ -266,8 +277,9 @@ def aero_along(aircraft: Aircraft, ic: InitialCondition, states: Mapping[str, np
 
 
 def initial_condition(t: np.ndarray, V: np.ndarray, alpha: np.ndarray, h: np.ndarray | None,
-                      window_s: float = START_WINDOW_S) -> InitialCondition:
+                      window_s: float = START_WINDOW_S, phi: np.ndarray | None = None) -> InitialCondition:
     """The recording's initial condition: means over its first ``window_s`` seconds."""
     k = start_samples(t, window_s)
     return InitialCondition(h_ft=float(np.mean(h[:k])) if h is not None else 10_000.0,
-                            V_fps=float(np.mean(V[:k])), alpha_rad=float(np.mean(alpha[:k])))
+                            V_fps=float(np.mean(V[:k])), alpha_rad=float(np.mean(alpha[:k])),
+                            phi_rad=float(np.mean(phi[:k])) if phi is not None else 0.0)

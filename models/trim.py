@@ -146,6 +146,10 @@ def trim(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition) 
     torque = turboprop and fdm.get_property_manager().hasNode(next(iter(TRIM_MOMENT_PROPERTIES.values())))
     held: dict = {}
     method = "jsbsim"
+    if condition.bank_deg and not turboprop and _trim_in_turn(fdm, condition.bank_deg):
+        fdm["propulsion/fuel_freeze"] = 1
+        return read_trim_point(fdm, condition.name, aircraft.surfaces,
+                               configuration=configuration_record(fdm, config, written), method="jsbsim-turn")
     try:
         with _quiet_stdout():
             fdm.do_trim(0)
@@ -182,6 +186,21 @@ def _first_run_ic(fdm: jsbsim.FGFDMExec, aircraft: Aircraft) -> None:
         raise AircraftError(f"{aircraft.model}: JSBSim cannot initialise this aircraft as it stands "
                             f"(JSBSim: {str(exc).strip()}): its XML reads something JSBSim alone does not define "
                             "(FlightGear may); sidbench needs a model JSBSim can fly by itself") from exc
+
+
+def _trim_in_turn(fdm: jsbsim.FGFDMExec, bank_deg: float) -> bool:
+    """JSBSim's steady coordinated turn at ``bank_deg`` (``do_trim(5)``); False, the instance
+    back at wings level, where it fails (the wings-level trim follows)."""
+    fdm["ic/phi-deg"] = bank_deg
+    fdm.run_ic()
+    try:
+        with _quiet_stdout():
+            fdm.do_trim(5)
+        return True
+    except jsbsim.TrimFailureError:
+        fdm["ic/phi-deg"] = 0.0
+        fdm.run_ic()
+        return False
 
 
 def _initialise_in_cruise(fdm: jsbsim.FGFDMExec, aircraft: Aircraft, condition: FlightCondition):

@@ -221,3 +221,23 @@ def test_an_aircraft_whose_aerodynamics_read_normalised_surfaces_is_refused_by_n
     with pytest.raises(AircraftError, match=r"read fcs/elevator-pos-norm instead.*de input"):
         xml_surface_properties(str(library_xml("T38")))
     assert xml_surface_properties(str(library_xml("c172p")))["de"] == "fcs/elevator-pos-rad"
+
+
+def test_a_recording_that_starts_banked_trims_the_model_in_that_steady_turn():
+    """models.replay.InitialCondition: a record starting 45° banked is trimmed in JSBSim's
+    steady coordinated turn there — bank 45°, load factor 1/cos 45° (its normal specific
+    force), turn rate g·tan φ / V (ψ̇), and more thrust than wings level (308 lbf against 281) — so that a
+    propeller's slipstream over the tail is the banked flight's; under 5° it stays wings level."""
+    from models.replay import TURN_BANK_MIN_DEG, InitialCondition
+    path = f"{jsbsim.get_default_root_dir()}/aircraft/c172x/c172x.xml"
+    aircraft = Aircraft(path)
+    turn = InitialCondition(5000.0, 185.0, phi_rad=math.radians(45.0))
+    fdm = load_fdm(aircraft, 1 / 120)
+    tp = trim(fdm, aircraft, turn.condition())
+    assert tp.method == "jsbsim-turn" and math.degrees(tp.phi_rad) == pytest.approx(45.0, abs=0.1)
+    n = -fdm["forces/fbz-total-lbs"] / (fdm["inertia/mass-slugs"] * 32.174)
+    assert n == pytest.approx(1 / math.cos(math.radians(45.0)), rel=0.01)
+    assert fdm["velocities/psidot-rad_sec"] == pytest.approx(fdm["accelerations/gravity-ft_sec2"] / 185.0, rel=0.02)
+    level = trim(load_fdm(aircraft, 1 / 120), aircraft,
+                 InitialCondition(5000.0, 185.0, phi_rad=math.radians(TURN_BANK_MIN_DEG / 2)).condition())
+    assert level.method == "jsbsim" and abs(level.phi_rad) < 0.01 and tp.thrust_lbf > 1.05 * level.thrust_lbf

@@ -247,3 +247,15 @@ def test_axes_their_own_terms_imitate_are_no_second_test():
     # two axes, each as a small change of its own rate derivative (an F-16's V scale, kinematic t 3.2)
     assert imitated_by_own_terms((ax("Cl", 1.64, 0.41, 0.998, 0.025), ax("Cm", 1.46, 0.43, 0.99999, 0.012))) != ""
     assert imitated_by_own_terms((ax("Cl", 1.0, 0.2, 1.0, 0.09), ax("Cn", 1.0, 0.2, 1.0, 0.01))) == ""
+
+
+def test_one_axis_needs_the_kinematics_at_three_standard_errors():
+    """corroborate.one_axis_and_a_weak_suspicion: a c182 in a banked turn whose C_m carried an
+    α² change had a q scale named from C_m alone (0.90 ± 0.15) and the kinematics at t 2.5; at
+    t 3 and beyond, or with a second axis showing it, the two tests may name it."""
+    from harness.diagnosis.corroborate import ONE_AXIS_KINEMATIC_T, one_axis_and_a_weak_suspicion
+    cm = AxisRatio("Cm", 0.90, 0.15, imitator="Cm_de", imitator_r=0.936, share=0.042)
+    v = corroborate("scale_q", 0.0344, 0.0344 / 2.5, {"Cm": cm}, t_aero=5.0)
+    assert not v.named and "only Cm shows it" in v.reason
+    assert corroborate("scale_q", 0.0344, 0.0344 / ONE_AXIS_KINEMATIC_T, {"Cm": cm}, t_aero=5.0).named
+    assert one_axis_and_a_weak_suspicion((cm, AxisRatio("CZ", 1.0, 0.3)), 2.5) == ""

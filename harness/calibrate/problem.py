@@ -129,7 +129,8 @@ def maneuver(rec, outputs: tuple[str, ...] | None = None, hold: str = "linear") 
         raise CalibrationError(f"recording {rec.name!r} lacks the output channels {', '.join(absent) or 'all'} "
                                f"(it has {', '.join(o for o in OUTPUTS if rec.has(o)) or 'none of them'})")
     t = rec.t
-    ic = initial_condition(t, rec.channel("V"), rec.channel("alpha"), _altitude(rec))
+    ic = initial_condition(t, rec.channel("V"), rec.channel("alpha"), _altitude(rec),
+                           phi=rec.channel("phi") if rec.has("phi") else None)
     surfaces = {s: steady_start(rec.channel(s), t) for s in SURFACES if rec.has(s)}
     z = np.column_stack([rec.channel(o) for o in outputs])
     return Maneuver(name=str(rec.name), t=np.asarray(t, dtype=float), surfaces=surfaces, ic=ic,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from harness.diagnosis.along import corrected_recording, inertial_beta, model_along, slope_function
+from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
 from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_test, gust_verdict, light_gusts,
                                           spectral_candidates, turbulence_test, vane_wander, withhold_in_light_gusts,
@@ -89,13 +90,14 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     if not propeller:
         withhold_thrust_drift(cands, p, aero.trim)
     if step.pinned is not None:
-        cands.append(pinned_shift(step.pinned))
+        cands.append(pinned_shift(step.pinned, p, aero.trim))
     withhold_on_moving_throttle(cands, p, propeller)
     # the rules that keep a term from being named when something else would imitate it
     withhold_explained_by_cg(cands, step.selections, mismatch, p)
     withhold_explained_by_lift(cands, step.selections, mismatch, p)
     withhold_explained_by_force_arm(cands, step.selections, mismatch, p, aero.trim)
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
+    withhold_lateral_drift_a_slow_sideslip_makes(cands, step, p, mismatch, slope_of)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
     withhold_even_term_off_the_quiet_flight(cands, step, p, mismatch)
     withhold_force_drift_off_the_vane_wander(cands, step, p, mismatch, slope_of, wander_gust, V0)

@@ -104,7 +104,7 @@ def _true_start(p: Prepared, added: tuple[HiddenEffect, ...]):
             ch[e.channel] = ch[e.channel] - e.size
         elif e.channel in ch and e.effect == "sensor_scale":
             ch[e.channel] = ch[e.channel] / (1.0 + e.size)
-    return initial_condition(p.t, ch["V"], ch["alpha"], ch.get("h"))
+    return initial_condition(p.t, ch["V"], ch["alpha"], ch.get("h"), phi=p.smooth.get("phi"))
 
 
 def _replay_surfaces(p: Prepared) -> dict[str, np.ndarray]:
@@ -141,7 +141,8 @@ def analysed(rec, role: str, aircraft: Aircraft) -> tuple[Prepared, Analysis, Re
     process can take)."""
     p = prepare(rec, role)
     check_time_base(p)
-    a = analyse(p, aircraft, initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude))
+    a = analyse(p, aircraft, initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude,
+                                               phi=p.smooth.get("phi")))
     return p, a, replay_before(p, aircraft, a)
 
 

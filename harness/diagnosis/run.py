@@ -232,7 +232,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     p = prepare(recs["identification"], "identification")
     check_time_base(p)
-    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude)
+    ic = initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude, phi=p.smooth.get("phi"))
     reference = choose_reference_point(p, aircraft, ic, aero_reference)
     if reference is not None:
         aircraft = reference.aircraft

@@ -64,6 +64,7 @@ def _axis_ratios(cands: list[Candidate], step: StepwiseFits, inner: slice, base:
         kept = {c.parameter for c in cands if c.selected and c.channel == axis} - skip
         others = [by_key[k].column[inner] for k in sel.names if k in by_key and by_key[k].parameter in kept]
         others += [col[inner] for col in step.nuisances.get(axis, {}).values() if np.ptp(col[inner]) > 0]
+        others += pinned_shift_columns(cands, p, axis, inner)
         offered = {t.parameter: t.column[inner] for k, t in by_key.items()
                    if t.parameter not in kept and np.ptp(t.column[inner]) > 0}
         excursion = float(np.std(p.measured[axis][inner])) if p is not None and axis in p.measured else np.nan
@@ -72,6 +73,21 @@ def _axis_ratios(cands: list[Candidate], step: StepwiseFits, inner: slice, base:
         if r is not None:
             out[axis] = r
     return out
+
+
+def pinned_shift_columns(cands: list[Candidate], p: Prepared | None, axis: str, inner: slice) -> list[np.ndarray]:
+    """The column of a moment-reference shift named from C_m's mistrim
+    (:func:`stepwise_axes.pinned_shift`) on ``axis``: C_Z for C_m, C_Y for C_n (effects.md's
+    cg_offset). Such a shift is no term of the axes' stepwise fits, which were made with it
+    taken out of the mismatch, so a fit beside their named terms must carry it itself: on an
+    independent script's c172p in a 45° banked turn with the moment reference 9 in aft (named,
+    0.60 ft), C_m followed a q skew's signature 2.8 ± 0.4 times the kinematics' −11 ms, the
+    shift's C_Z column left in it, and a q skew of −17 ms was named beside the shift."""
+    named = any(c.selected and c.effect == "cg_offset" and c.test.startswith("the mistrim") for c in cands)
+    column = {"Cm": "CZ", "Cn": "CY"}.get(axis)
+    if not named or p is None or column not in p.measured:
+        return []
+    return [p.measured[column][inner]]
 
 
 # The vane scale factor at which its signature is evaluated (the fit scales it).

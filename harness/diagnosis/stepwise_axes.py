@@ -170,16 +170,29 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
     return StepwiseFits(selections, nuisances, not_offered, shares, pinned)
 
 
-def pinned_shift(test: CgMeanTest) -> Candidate:
+def pinned_shift(test: CgMeanTest, p: Prepared | None = None, trim: TrimPoint | None = None) -> Candidate:
     """The moment-reference shift C_m's mistrim says (:func:`_cg_mean_test`), a candidate
-    named when significant (the entry t) and practical (the mistrim at least
-    :data:`candidates.PRACTICAL_SHARE` of C_m's excursion)."""
+    named when significant (the entry t), practical (the mistrim at least
+    :data:`candidates.PRACTICAL_SHARE` of C_m's excursion) and, given the recording ``p`` and
+    the model's ``trim``, beyond the mistrim the thrust's own moment can make
+    (:func:`thrust_mistrim_bound`) by two standard errors."""
     t = test.dx_ft / test.std_error_ft if test.std_error_ft > 0 else 0.0
     sel = abs(t) >= cand.T_IN and _practical(test.share)
+    reason = "entered" if sel else ("not entered" if abs(t) < cand.T_IN else _impractical_reason(test.share))
+    details = {"mistrim_share": test.share}
+    if sel and p is not None and trim is not None:
+        cbar, cz = p.meta["geometry"]["cbar_ft"], float(np.mean(p.measured["CZ"][interior(p)]))
+        mistrim, se = abs(test.dx_ft * cz / cbar), abs(test.std_error_ft * cz / cbar)
+        bound = thrust_mistrim_bound(p, trim)
+        details["thrust_mistrim_bound"] = bound
+        if mistrim - 2.0 * se < bound:
+            sel = False
+            reason = (f"not named: C_m's mistrim ({mistrim:.2g} ± {se:.1g}) is within what the thrust's moment "
+                      f"through a thrust line {thrust_line_offset(p, trim):.2f} ft from the c.g. can make "
+                      f"({bound:.2g}): thrust and its line were not recorded")
     return Candidate("cg_offset", cand.AXIS_NAME["Cm"], "Cm", "dx_moment_reference", test.dx_ft, test.std_error_ft,
-                     t, test.explained, "ft", "the mistrim of C_m (its constant over the mean of C_Z)", sel,
-                     "entered" if sel else ("not entered" if abs(t) < cand.T_IN else _impractical_reason(test.share)),
-                     {"mistrim_share": test.share})
+                     t, test.explained, "ft", "the mistrim of C_m (its constant over the mean of C_Z)", sel, reason,
+                     details)
 
 
 def _without_shift(p: Prepared, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray],
@@ -300,6 +313,20 @@ def thrust_line_offset(p: Prepared, trim: TrimPoint) -> float:
     """The thrust line's distance from the c.g. (ft): the larger of the metadata's
     ``thrust_offset_ft`` and the model's own at its trim."""
     return max(abs(float(p.meta.get("thrust_offset_ft", 0.0))), abs(trim.thrust_offset_ft))
+
+
+def thrust_mistrim_bound(p: Prepared, trim: TrimPoint) -> float:
+    """The C_m mistrim the thrust's own moment can make when thrust is not recorded:
+    ``T · |z_T| / (q̄ S c̄)``, T and q̄ at the model's trim, z_T from
+    :func:`thrust_line_offset` (zero with a thrust channel and the metadata's
+    ``thrust_offset_ft``: Eqs. 1 and 4 then take the moment out). An independent script's A-4
+    (thrust line 1.04 ft above its c.g.) in a 20° banked turn at 550 ft/s had a C_m constant
+    of −0.0027 on its null, −0.0026 with C_m,α −0.25, where the stepwise entered a shift for
+    the C_m,α change and the shift the mistrim says, 0.114 ft aft, was named."""
+    if "thrust" in p.raw and "thrust_offset_ft" in p.meta:
+        return 0.0
+    geo = p.meta["geometry"]
+    return abs(trim.thrust_lbf) * thrust_line_offset(p, trim) / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"])
 
 
 def thrust_moment_bound(p: Prepared, trim: TrimPoint) -> float:

@@ -3,6 +3,8 @@ what the recording could not check and what was assumed, and a model that cannot
 represent the recording refused (:class:`DiagnosisError`)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from harness.diagnosis import candidates as cand
@@ -16,6 +18,7 @@ from harness.diagnosis.sensor_rules import steady_vane, steady_vane_reason
 from harness.diagnosis.stepwise_axes import NOT_WITH_THROTTLE
 from models.aircraft import Aircraft, other_fcs_properties
 from models.constants import SURFACES
+from models.replay import TURN_BANK_MIN_DEG
 
 
 EXPLAIN = {
@@ -494,6 +497,16 @@ def assumptions(a: Analysis, aircraft: Aircraft, mass: str, surfaces_note: dict 
                                 + _mass_difference(a.prepared.mass, a.aero.trim)
                                 + "); --mass recording flies it with the recording's")})
     trim = a.aero.trim
+    if trim.method == "jsbsim-turn":
+        out.append({"item": "model trim (bank)", "missing": "-",
+                    "stood_in_by": f"the recording starts banked {math.degrees(trim.phi_rad):.0f}°: the model is "
+                                   "trimmed in a steady coordinated turn there (JSBSim's turn trim), its engine at "
+                                   "that turn's power"})
+    elif abs(math.degrees(a.ic.phi_rad)) >= TURN_BANK_MIN_DEG:
+        out.append({"item": "model trim (bank)", "missing": "-",
+                    "stood_in_by": f"the recording starts banked {math.degrees(a.ic.phi_rad):.0f}°, but the model is "
+                                   "trimmed wings level (no steady turn found there): its engine at level "
+                                   "flight's power"})
     if trim.held:
         for surface, info in trim.held.items():
             out.append({"item": f"model trim ({surface})", "missing": "-", "stood_in_by": info["reason"]})

@@ -1,0 +1,75 @@
+"""Terms a slow sideslip error or the thrust line imitates (harness.diagnosis.drift_rules,
+stepwise_axes.pinned_shift), pinned to constructed mismatches whose source is known."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from harness.diagnosis.candidates import Term
+from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
+from harness.diagnosis.evidence import Candidate
+
+N, DT = 1500, 0.02
+SLOPES = {"CY": -1.1, "Cl": -0.11, "Cn": 0.19}   # C_β per rad, an F-16's order
+NOISE = {"CY": 0.002, "Cl": 0.0002, "Cn": 0.0003}
+
+
+def _setup(sizes: dict[str, float], k_rad: float, seed: int = 3):
+    """Lateral mismatches carrying −C_β·k·ΔV/V (a sideslip error following the drift column)
+    plus an aerodynamic drift ``sizes[axis]``·ΔV/V, white noise, and each axis's stepwise
+    fit with the drift term selected; returns the candidates, the step and the mismatches."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(N) * DT
+    drift = 0.08 * (1.0 - np.exp(-t / 8.0))     # ΔV/V rising and levelling, as after a pitch doublet
+    mismatch, selections, cands = {}, {}, []
+    for axis, slope in SLOPES.items():
+        mismatch[axis] = -slope * k_rad * drift + sizes.get(axis, 0.0) * drift + NOISE[axis] * rng.normal(size=N)
+        term = Term("dV", "flight_condition_drift", f"{axis}_dV", "", drift)
+        selections[axis] = (SimpleNamespace(names=("dV",), params={"dV": 1.0}), {"dV": term})
+        cands.append(Candidate("flight_condition_drift", None, axis, f"{axis}_dV", 1.0, 0.1, 10.0, 0.1, "",
+                               f"stepwise on the {axis} mismatch", selected=True, reason="entered"))
+    step = SimpleNamespace(selections=selections, nuisances={})
+    slopes = {axis: np.full(N, s) for axis, s in SLOPES.items()}
+    return cands, step, SimpleNamespace(n=N, dt=DT), mismatch, lambda x: slopes
+
+
+def test_drifts_in_the_model_s_beta_proportions_are_a_drifting_sideslip():
+    """Δβ = 1.5°·ΔV/V (the F-16 null's k) on every lateral axis: the three drift terms
+    are withheld, and the reason carries the common k."""
+    cands, step, p, mismatch, slope_of = _setup({}, np.radians(1.5))
+    withhold_lateral_drift_a_slow_sideslip_makes(cands, step, p, mismatch, slope_of)
+    assert not any(c.selected for c in cands)
+    import re
+    k, se = map(float, re.search(r"k = ([-\d.]+) ± ([\d.]+) deg", cands[0].reason).groups())
+    assert abs(k - 1.5) < 3 * se  # the common k within three of its standard errors
+
+
+def test_a_drift_of_one_axis_s_aerodynamics_is_not_a_sideslip():
+    """A C_n ΔV/V drift alone (C_Y and C_l flat) is not the β proportions: kept."""
+    cands, step, p, mismatch, slope_of = _setup({"Cn": -0.006}, 0.0)
+    for c in cands:
+        c.selected = c.channel == "Cn"
+    withhold_lateral_drift_a_slow_sideslip_makes(cands, step, p, mismatch, slope_of)
+    assert [c.parameter for c in cands if c.selected] == ["Cn_dV"]
+
+
+def test_a_mistrim_the_thrust_line_can_make_names_no_moment_reference_shift():
+    """stepwise_axes.pinned_shift: the A-4's thrust line is 1.04 ft above its c.g.; 1,817 lbf
+    of thrust at q̄ 265 psf (S 260 ft², c̄ 10.8 ft) mistrims C_m by 0.0025 when thrust is not
+    recorded, so the 0.114 ft shift its C_m constant says (−0.0024 ± 0.0002 at a mean C_Z of
+    −0.2) is not named; a shift mistrimming C_m five times that is; with thrust and its line
+    recorded, the bound is zero."""
+    from harness.diagnosis.stepwise_axes import CgMeanTest, pinned_shift, thrust_mistrim_bound
+    p = SimpleNamespace(n=N, dt=DT, raw={}, meta={"geometry": {"S_ft2": 260.0, "b_ft": 27.5, "cbar_ft": 10.8}},
+                        measured={"CZ": np.full(N, -0.2)})
+    trim = SimpleNamespace(thrust_lbf=1817.0, thrust_offset_ft=-1.04, qbar_psf=265.0)
+    bound = thrust_mistrim_bound(p, trim)
+    assert bound == np.float64(1817.0 * 1.04 / (265.0 * 260.0 * 10.8))
+    test = CgMeanTest(True, "", 0.114, 0.011, True, 0.12, 0.4)
+    c = pinned_shift(test, p, trim)
+    assert not c.selected and "thrust" in c.reason and c.details["thrust_mistrim_bound"] == bound
+    assert pinned_shift(test._replace(dx_ft=0.6, std_error_ft=0.02), p, trim).selected
+    recorded = SimpleNamespace(**{**vars(p), "raw": {"thrust": np.zeros(N)},
+                                  "meta": {**p.meta, "thrust_offset_ft": 1.04}})
+    assert thrust_mistrim_bound(recorded, trim) == 0.0 and pinned_shift(test, recorded, trim).selected
