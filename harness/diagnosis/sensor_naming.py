@@ -83,7 +83,7 @@ def pinned_shift_columns(cands: list[Candidate], p: Prepared | None, axis: str, 
     independent script's c172p in a 45° banked turn with the moment reference 9 in aft (named,
     0.60 ft), C_m followed a q skew's signature 2.8 ± 0.4 times the kinematics' −11 ms, the
     shift's C_Z column left in it, and a q skew of −17 ms was named beside the shift."""
-    named = any(c.selected and c.effect == "cg_offset" and c.test.startswith("the mistrim") for c in cands)
+    named = any(c.selected and c.effect == "cg_offset" and "mistrim_share" in c.details for c in cands)
     column = {"Cm": "CZ", "Cn": "CY"}.get(axis)
     if not named or p is None or column not in p.measured:
         return []
