@@ -73,3 +73,36 @@ def test_a_mistrim_the_thrust_line_can_make_names_no_moment_reference_shift():
     recorded = SimpleNamespace(**{**vars(p), "raw": {"thrust": np.zeros(N)},
                                   "meta": {**p.meta, "thrust_offset_ft": 1.04}})
     assert thrust_mistrim_bound(recorded, trim) == 0.0 and pinned_shift(test, recorded, trim).selected
+
+
+def _kinematics(r_rate: float, q_rate: float, dV: float, daz: float, seed: int = 5):
+    """Stacked v̇ and ẇ residuals of a record whose airspeed reads ``dV`` high and whose a_z
+    reads ``daz`` (ft/s²) high, the rates steady at ``r_rate``, ``q_rate`` (a turn) plus a
+    small maneuver; the forced accelerometer biases' and the airspeed bias's columns."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(N) * DT
+    r = r_rate + 0.02 * np.sin(0.9 * t)
+    q = q_rate + 0.02 * np.sin(1.7 * t + 1.0)
+    one, zero = np.ones(N), np.zeros(N)
+    cols = {"bias_ay": np.concatenate([one, zero]), "bias_az": np.concatenate([zero, one]),
+            "bias_V": np.concatenate([-r, q])}
+    start = dV * cols["bias_V"] + daz * cols["bias_az"] + 0.05 * rng.normal(size=2 * N)
+    kin = SimpleNamespace(columns=cols, start=start, forced=("bias_ay", "bias_az"),
+                          selection=SimpleNamespace(names=()))
+    cands = [Candidate("sensor_bias", None, c[5:], c, 0.0, 0.01, 10.0, 0.0, "g", "kinematic consistency (bias always "
+                       "fitted)", selected=True) for c in ("bias_ay", "bias_az")]
+    return kin, cands
+
+
+def test_accelerometer_biases_an_airspeed_bias_makes_in_a_turn_are_not_named():
+    """sensor_rules.withhold_biases_an_airspeed_bias_makes: in a steady 30° turn at 153 ft/s
+    (r 0.105, q 0.061 rad/s) an airspeed 10 ft/s high reads as a_y and a_z biases; beside an
+    airspeed bias they fall under the entry t and are withheld. In level flight a true a_z
+    bias (0.7 ft/s², 0.02 g) stands beside it."""
+    from harness.diagnosis.sensor_rules import withhold_biases_an_airspeed_bias_makes
+    kin, cands = _kinematics(0.105, 0.061, 10.0, 0.0)
+    withhold_biases_an_airspeed_bias_makes(cands, kin)
+    assert not any(c.selected for c in cands) and "airspeed bias" in cands[0].reason
+    kin, cands = _kinematics(0.0, 0.0, 0.0, 0.7)
+    withhold_biases_an_airspeed_bias_makes(cands, kin)
+    assert cands[1].selected

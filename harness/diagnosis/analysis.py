@@ -18,8 +18,8 @@ from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, 
                                              withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
                                             kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
-                                            steady_vane, withhold_offset_of_a_scaled_vane,
-                                            withhold_scale_a_bias_would_make)
+                                            steady_vane, withhold_biases_an_airspeed_bias_makes,
+                                            withhold_offset_of_a_scaled_vane, withhold_scale_a_bias_would_make)
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns, withhold_on_moving_throttle,
@@ -74,6 +74,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     air = air_share_test(p, aircraft, ic, along, slope_of, gust, V0) if turbulent or gusty or near else None
     turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
     cands = kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
+    withhold_biases_an_airspeed_bias_makes(cands, kin)
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
     as_evaluated = dict(mismatch)
