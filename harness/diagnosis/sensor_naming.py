@@ -7,8 +7,6 @@ import functools
 
 import numpy as np
 
-from estimators.colored_stepwise import colored_fit
-from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import corroborate
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along
@@ -16,7 +14,7 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
-                                            unit_members,
+                                            kinematic_t_beside, unit_members,
                                             kinematics_refute, sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
 from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel, term_change
@@ -324,13 +322,9 @@ def _withhold_absorbed_biases(cands: list[Candidate], kin: KinematicResult, drop
     """With the kinematic fit redone on ``rival`` in place of ``dropped`` (the two it cannot tell
     apart), a named bias whose |t| falls below the entry t is part of the rival's error (an α
     scale factor shifts α's mean by k·ᾱ, which a bias otherwise takes) and is not named."""
-    cols = kin.columns or {}
-    names = [n for n in kin.forced + kin.selection.names if n != dropped and n in cols] + [rival]
-    try:
-        theta, se, _ = colored_fit(kin.start, [cols[n] for n in names], names, constant=False)
-    except (SingularRegressorsError, np.linalg.LinAlgError):
+    t_alt = kinematic_t_beside(kin, rival, dropped) if rival in (kin.columns or {}) else None
+    if t_alt is None:
         return
-    t_alt = {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
     for c in cands:
         if c.selected and c.parameter in kin.forced and t_alt.get(c.parameter, np.inf) < cand.T_IN:
             c.selected = False

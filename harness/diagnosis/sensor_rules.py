@@ -337,20 +337,29 @@ def withhold_biases_an_airspeed_bias_makes(cands: list[Candidate], kin: Kinemati
     banked turn (153 ft/s) with V 10 ft/s high named a_y and a_z biases of −0.030 g and
     +0.022 g (t −45 and 35; −r̄ΔV/g and q̄ΔV/g are −0.033 g and +0.019 g) where the airspeed
     bias stood at t 3.7. In level flight the rates are near zero and the columns apart."""
-    cols = kin.columns or {}
-    if "bias_V" not in cols:
+    if "bias_V" not in (kin.columns or {}):
         return
-    names = [n for n in kin.forced + kin.selection.names if n in cols and n != "bias_V"] + ["bias_V"]
-    try:
-        theta, se, _ = colored_fit(kin.start, [cols[n] for n in names], names, constant=False)
-    except (SingularRegressorsError, np.linalg.LinAlgError):
+    t_beside = kinematic_t_beside(kin, "bias_V")
+    if t_beside is None:
         return
-    t_beside = {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
     for c in cands:
         if c.selected and c.parameter in ("bias_ax", "bias_ay", "bias_az") and t_beside[c.parameter] < cand.T_IN:
             c.selected = False
             c.reason = (f"not named: beside an airspeed bias it falls to t = {t_beside[c.parameter]:.1f} (the "
                         "kinematics cannot tell them apart where the rates hold steady, as in a turn)")
+
+
+def kinematic_t_beside(kin: KinematicResult, added: str, dropped: str = "") -> dict[str, float] | None:
+    """Each parameter's |t| in the kinematic fit of the forced and selected terms (``dropped``
+    left out) with ``added`` fitted beside them (colored-residual standard errors, no
+    constant); None when the columns are dependent."""
+    cols = kin.columns or {}
+    names = [n for n in kin.forced + kin.selection.names if n in cols and n not in (dropped, added)] + [added]
+    try:
+        theta, se, _ = colored_fit(kin.start, [cols[n] for n in names], names, constant=False)
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return None
+    return {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
 
 
 # The |t| a kinematic estimate needs before it corrects the channels the model is evaluated on.
