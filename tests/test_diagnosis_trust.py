@@ -436,6 +436,38 @@ def test_a_sensor_suspicion_the_validation_maneuver_does_not_share_is_lifted(mon
         assert lift_unreplicated_suspicions(a, SimpleNamespace(kinematic=kin(-0.0548, 2.52))) == []
 
 
+def test_a_suspicion_made_at_a_size_of_its_own_is_compared_at_that_size(monkeypatch):
+    """replication._suspected_at: a suspicion that withheld a term at the size of a contested
+    suspect's rival (``suspicion['at']``, term_rules.withhold_ambiguous) is compared with the
+    validation's estimate at that size. A T-6 with a_z 40 ms late: the skew sized in its
+    suspect's place at 40 ± 5 ms withheld C_Z,α̇ +32; the kinematic fit's −17 ± 20 ms beside
+    the suspect lay 3.3 standard errors from the validation's 54 ± 9 ms and lifted it. At the
+    suspicion's own size the validation agrees (a suspicion of the same sign): not lifted."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis import replication
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.replication import _suspected_at, lift_unreplicated_suspicions
+    monkeypatch.setattr(replication, "_kinematics_trusted", lambda a: True)
+
+    def kin(v, se):
+        return SimpleNamespace(selection=SimpleNamespace(params={}, terms=[
+            SimpleNamespace(name="skew_az", estimate=v, t=v / se, std_error=se)]))
+
+    def identification(at):
+        suspicion = {"parameter": "skew_az", "t": 7.5} | ({"at": [0.0405, 0.0054]} if at else {})
+        term = Candidate("unsteady_alphadot", "lon", "CZ", "CZ_alphadot", 32.2, 2.1, 15.5, 0.6, "per rad",
+                         "stepwise on the CZ mismatch", False, "entered, but not named: ...",
+                         {"sensor_rival": "skew_az", "suspicion": suspicion})
+        return SimpleNamespace(candidates=[term], kinematic=kin(-0.0167, 0.0195))
+
+    validation = SimpleNamespace(kinematic=kin(0.054, 0.0092))
+    assert _suspected_at(identification(True), identification(True).candidates[0].details["suspicion"])[0] == 0.0405
+    assert lift_unreplicated_suspicions(identification(False), validation) != []   # the fit's size: lifted
+    a = identification(True)
+    assert lift_unreplicated_suspicions(a, validation) == [] and not a.candidates[0].selected
+
+
 def test_an_accelerometer_offset_is_explained_along_its_own_axis():
     """verdict._offset_direction: a lateral offset is 'right of' or 'left of' the c.g. (y), a
     vertical one 'below' or 'above' (z, body axes down), the force fit's x 'ahead of'."""
@@ -667,7 +699,8 @@ def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
     lateral C_n fit suggests (C_n ∝ C_Y looks like C_n,β) is refuted when C_m's constant
     falls short of Δx·mean(C_Z)/c̄ by more than CG_MEAN_SHARE of it and CG_MEAN_Z standard
     errors; the shift's own mistrim, or a larger one of the same sign, supports it. A short
-    constant that is itself a shift of the same sign is that shift, pinned (c̄·constant/mean C_Z)."""
+    constant that is itself a shift of the same sign is that shift, pinned (c̄·constant/mean C_Z),
+    when C_m's own stepwise entered the shift; one read off C_n is refuted only."""
     from types import SimpleNamespace
 
     import numpy as np
@@ -693,8 +726,14 @@ def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
     none = verdict(0.0)                                                      # no mistrim at all
     assert none.refuted and not none.pinned and "refuted by the mean of C_m" in none.reason
     short = verdict(0.25 * (1.0 - CG_MEAN_SHARE) * predicted)               # far short, same sign
-    assert short.refuted and short.pinned and "named instead" in short.reason
-    assert abs(short.dx_ft - 0.25 * (1.0 - CG_MEAN_SHARE) * dx) < 5 * short.std_error_ft + 1e-3
+    assert short.refuted and not short.pinned                                # C_n's shift: refuted only
+    entered_on_cm = {"Cm": (SimpleNamespace(names=("cg",), params={"cg": dx / cbar}),
+                            {"cg": SimpleNamespace(scale=cbar, column=CZ)}),
+                     "Cn": (SimpleNamespace(names=(), params={}), {})}
+    mismatch = {"Cm": 0.25 * (1.0 - CG_MEAN_SHARE) * predicted + noise, "Cn": noise}
+    pinned = _cg_mean_test(p, "Cm", entered_on_cm, {}, mismatch, measured)
+    assert pinned.refuted and pinned.pinned and "named instead" in pinned.reason
+    assert abs(pinned.dx_ft - 0.25 * (1.0 - CG_MEAN_SHARE) * dx) < 5 * pinned.std_error_ft + 1e-3
     assert not verdict(-predicted).pinned                                    # the other sign: refuted only
     assert not verdict(predicted).refuted                                    # the shift's own mistrim
     assert not verdict(1.6 * predicted).refuted                              # a larger one supports it

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from harness.diagnosis.run import diagnose
-from independent_script import fly
+from independent_script import fly, inputs
 
 
 def _found(result):
@@ -169,24 +169,26 @@ def test_an_accelerometer_lag_is_named_and_the_alphadot_it_imitates_is_not(tmp_p
     assert not term["selected"] and "skew_az" in term["reason"], term["reason"]
 
 
-def _f16_copy(root, edit) -> str:
-    """A JSBSim root holding an F-16 whose XML is the package's passed through ``edit`` (text to
-    text), the package's engines and systems linked."""
+def _f16_copy(root, edit, model: str = "f16") -> str:
+    """A JSBSim root holding an F-16 (or the package's ``model``) whose XML is the package's
+    passed through ``edit`` (text to text), the package's engines and systems linked."""
     import jsbsim
     stock = Path(jsbsim.get_default_root_dir())
-    (root / "aircraft" / "f16").mkdir(parents=True)
+    (root / "aircraft" / model).mkdir(parents=True)
     for d in ("engine", "systems"):
         (root / d).symlink_to(stock / d)
-    for f in (stock / "aircraft" / "f16").iterdir():
-        if f.name != "f16.xml":
-            (root / "aircraft" / "f16" / f.name).symlink_to(f)
-    (root / "aircraft" / "f16" / "f16.xml").write_text(edit((stock / "aircraft" / "f16" / "f16.xml").read_text()))
+    for f in (stock / "aircraft" / model).iterdir():
+        if f.name != f"{model}.xml":
+            (root / "aircraft" / model / f.name).symlink_to(f)
+    xml = stock / "aircraft" / model / f"{model}.xml"
+    (root / "aircraft" / model / f"{model}.xml").write_text(edit(xml.read_text()))
     return str(root)
 
 
-def _f16_with_extra_term(root, axis: str, properties: tuple[str, ...], value: float, factors: str = "") -> str:
-    """An F-16 (:func:`_f16_copy`) whose ``axis`` carries one more aerodynamic function, the
-    product of ``properties``, the raw XML ``factors`` and ``value``."""
+def _f16_with_extra_term(root, axis: str, properties: tuple[str, ...], value: float, factors: str = "",
+                         model: str = "f16") -> str:
+    """An F-16 (or ``model``, :func:`_f16_copy`) whose ``axis`` carries one more aerodynamic
+    function, the product of ``properties``, the raw XML ``factors`` and ``value``."""
     props = "".join(f"<property>{p}</property>" for p in properties)
     extra = (f'<function name="aero/coefficient/extra"><product>{props}{factors}<value>{value}</value></product>'
              '</function>\n')
@@ -194,7 +196,7 @@ def _f16_with_extra_term(root, axis: str, properties: tuple[str, ...], value: fl
     def edit(text: str) -> str:
         end = text.index("</axis>", text.index(f'<axis name="{axis}">'))
         return text[:end] + extra + text[end:]
-    return _f16_copy(root, edit)
+    return _f16_copy(root, edit, model)
 
 
 def _f16_with_reference_moved(root, aft_in: float) -> str:
@@ -377,3 +379,109 @@ def test_a_late_roll_gyro_is_named_not_a_bank_skew_and_aileron_delay(tmp_path):
     result = diagnose(model, rec, tmp_path / "out", calibrate=False)
     found = _found(result)
     assert [p for p, _ in found] == ["skew_p"] and found[0][1] == pytest.approx(0.04, abs=0.006)
+
+
+def _package_xml(model: str) -> str:
+    import jsbsim
+    return str(Path(jsbsim.get_default_root_dir()) / "aircraft" / model / f"{model}.xml")
+
+
+def test_a_yaw_stability_change_names_no_shift_from_the_pitching_moment_s_constant(tmp_path):
+    """The package's T-6 (11,000 ft / 360 ft/s, lateral multisine at 40 Hz) with C_n,β 0.03
+    higher in an XML copy: C_n's stepwise entered a moment-reference shift for it (its C_Y
+    column follows β), which C_m's constant refuted, and that constant, the model's own
+    mistrim, was then taken as the shift and named first (0.064 ft, t 120). A shift is sized by C_m's constant
+    only when C_m's own stepwise entered it (stepwise_axes._cg_mean_test); C_n,β is named."""
+    import independent_script
+    independent_script.SURFACE_PROPERTIES.setdefault(
+        "t6texan2", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    root = _f16_with_extra_term(tmp_path / "root", "YAW", ("aero/qbar-psf", "metrics/Sw-sqft", "metrics/bw-ft",
+                                                           "aero/beta-rad"), 0.03, model="t6texan2")
+    rec = fly(tmp_path / "id.csv", "t6texan2", 11192.0, 359.2, 1, 40.0, "ms_lat", amplitude_deg=2.44, root=root)
+    result = diagnose(_package_xml("t6texan2"), rec, tmp_path / "out", calibrate=False)
+    assert [p for p, _ in _found(result)] == ["Cn_beta"]
+    assert result["findings"][0]["evidence"]["change"] == pytest.approx(0.03, rel=0.25)
+    assert not any(c["parameter"] == "dx_moment_reference" and c["selected"] for c in result["candidates"])
+
+
+def _doublets_3211(kind, amplitude_rad, duration_s, rng):
+    """3-2-1-1 inputs on each axis in turn (stabilator at 1 s, 0.6 s base; aileron at 7 s, 0.5 s;
+    rudder at 13 s, 0.7 s): the multistep a flight-test card flies."""
+    t = np.arange(0.0, duration_s, 0.01)
+
+    def steps(t0, base):
+        u = np.zeros_like(t)
+        for (a, b), v in zip(((0, 3), (3, 5), (5, 6), (6, 7)), (1, -1, 1, -1)):
+            u[(t >= t0 + a * base) & (t < t0 + b * base)] = v
+        return amplitude_rad * u
+    return {"de": steps(1.0, 0.6), "da": steps(7.0, 0.5), "dr": steps(13.0, 0.7)}
+
+
+def test_a_sideslip_vane_bias_is_not_read_as_light_turbulence(tmp_path, monkeypatch):
+    """The package's A-4 (10,790 ft / 539 ft/s, 3-2-1-1 on each axis, doublet validation) with
+    its β vane 1° off: a side velocity V·b the roll carries into the w equation (−p·v), whose
+    integral followed the bank, read as light turbulence of 2.3 ft/s, and the bias the
+    kinematics put at t 16 was not applied. Asked again on the channels corrected for the
+    kinematics' biases (gust_biases.gusts_without_biases), the gusts are gone and the bias is
+    named at its size."""
+    import independent_script
+    independent_script.SURFACE_PROPERTIES.setdefault(
+        "A4", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    monkeypatch.setattr(independent_script, "inputs",
+                        lambda kind, a, d, rng: (_doublets_3211 if kind == "3211_3" else inputs)(kind, a, d, rng))
+    rec = fly(tmp_path / "id.csv", "A4", 10790.0, 538.7, 42, 50.0, "3211_3", units="deg", amplitude_deg=3.17)
+    val = fly(tmp_path / "val.csv", "A4", 10790.0, 538.7, 50042, 50.0, "dbl3", units="deg", amplitude_deg=3.17)
+    for path in (rec, val):
+        _sensor_error(path, "beta_deg", lambda t, x: x + 1.0)
+    result = diagnose(_package_xml("A4"), rec, tmp_path / "out", val, calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["bias_beta"] and np.degrees(found[0][1]) == pytest.approx(1.0, abs=0.1)
+    gust = next(c for c in result["candidates"] if c["parameter"] == "sigma_gust_fps")
+    assert not gust["selected"] and "bias_beta" in gust["reason"], gust["reason"]
+
+
+def _accelerometer_ahead(path, x_ft: float) -> None:
+    """Rewrite the script's CSV (degrees, g) as recorded by an accelerometer ``x_ft`` ahead of
+    the c.g.: a_z less x·q̇/g, a_y plus x·ṙ/g (q̇ and ṙ from the recorded rates by a 0.2 s
+    cubic Savitzky-Golay derivative, the gyros' noise mostly left out)."""
+    import csv
+
+    from scipy.signal import savgol_filter
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    head, X = rows[0], np.array(rows[1:], dtype=float)
+    dt = X[1, 0] - X[0, 0]
+    window = max(int(round(0.2 / dt)) | 1, 5)
+    qdot, rdot = (savgol_filter(np.radians(X[:, head.index(c)]), window, 3, deriv=1, delta=dt)
+                  for c in ("q_dps", "r_dps"))
+    X[:, head.index("az_g")] -= x_ft * qdot / 32.174
+    X[:, head.index("ay_g")] += x_ft * rdot / 32.174
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(head)
+        writer.writerows([[f"{v:.8g}" for v in row] for row in X])
+
+
+def test_an_accelerometer_ahead_of_the_cg_is_named_once(tmp_path, monkeypatch):
+    """The package's J-3 Cub (1,734 ft / 118 ft/s, a stabilator 3-2-1-1, 50 Hz, twice the
+    noise, doublet validation) with its accelerometer 4 ft ahead of the c.g.: the force
+    mismatch put it at 4.14 ± 0.25 ft (x_accelerometer) and the kinematics, corroborated on
+    the coefficients, at 3.34 ± 0.31 (offset_x); both were named, two findings of one
+    position. It is named once (sensor_rules.name_accelerometer_once), at the larger t."""
+    import independent_script
+    independent_script.SURFACE_PROPERTIES.setdefault(
+        "J3Cub", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    monkeypatch.setattr(independent_script, "inputs", lambda kind, a, d, rng: (
+        {k: v * (k == "de") for k, v in _doublets_3211(kind, a, d, rng).items()} if kind == "3211_pitch"
+        else inputs(kind, a, d, rng)))
+    rec = fly(tmp_path / "id.csv", "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
+              amplitude_deg=2.94)
+    val = fly(tmp_path / "val.csv", "J3Cub", 1734.0, 117.9, 50158, 50.0, "dbl3", units="deg", noise=2.0,
+              amplitude_deg=2.94)
+    for path in (rec, val):
+        _accelerometer_ahead(path, 4.0)
+    result = diagnose(_package_xml("J3Cub"), rec, tmp_path / "out", val, calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["x_accelerometer"] and found[0][1] == pytest.approx(4.0, rel=0.25)
+    twice = next(c for c in result["candidates"] if c["parameter"] == "offset_x")
+    assert not twice["selected"] and "named once" in twice["reason"], twice["reason"]

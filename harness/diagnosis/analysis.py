@@ -7,6 +7,7 @@ import numpy as np
 from harness.diagnosis.along import corrected_recording, inertial_beta, model_along, slope_function
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
+from harness.diagnosis.gust_biases import gusts_without_biases, note_gusts_of_biases
 from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_test, gust_verdict, light_gusts,
                                           spectral_candidates, turbulence_test, vane_wander, withhold_in_light_gusts,
                                           withhold_in_turbulence, withhold_vane_wander)
@@ -17,7 +18,8 @@ from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, 
                                              withhold_delays_imitated_by_named, withhold_imitated_by_named,
                                              withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
-                                            kinematics_plausible, plausible_kinematic_check, scale_read_as_bias,
+                                            kinematics_plausible, name_accelerometer_once,
+                                            plausible_kinematic_check, scale_read_as_bias,
                                             steady_vane, withhold_biases_an_airspeed_bias_makes,
                                             withhold_offset_of_a_scaled_vane, withhold_scale_a_bias_would_make)
 from harness.diagnosis.spectra import structural_peak
@@ -59,6 +61,10 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     near = "" if turbulent or gusty else light_gusts(gust, p, V0, LIGHT_TURBULENCE_FACTOR)
     # 1. sensors: kinematic consistency says what the instruments did
     kin = plausible_kinematic_check(p)
+    cleared = gusts_without_biases(p, kin, V0) if turbulent or gusty or near else None
+    if cleared is not None:  # the 'gust' was the kinematic signature of constant instrument errors
+        raw_gust, (gust, gust_biases) = gust, cleared
+        turbulent, gusty, near = False, "", light_gusts(gust, p, V0, LIGHT_TURBULENCE_FACTOR)
     plausible = kinematics_plausible(kin, V0, p)
     contested = contested_parameters(kin, p)
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
@@ -133,9 +139,12 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             withhold_offset_of_a_scaled_vane(cands, kin, p, aircraft, ic, as_evaluated, noise, sensor_values)
             withhold_imitated_by_named(cands, imitated, set(sensor_values))
             withhold_delays_imitated_by_named(cands, kin, p, aircraft, ic, aero.derivatives, noise, set(sensor_values))
+    name_accelerometer_once(cands)
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += spectral_candidates(peak, gust, turbulent, light, air)
+    if cleared is not None:
+        note_gusts_of_biases(cands, raw_gust, gust_biases)
     if turbulent or light:  # the gust as a process-noise model: filter error against output error
         next(c for c in cands if c.effect == "turbulence").details["process_noise_model"] = process_noise_model(p)
     return Analysis(prepared=p, ic=ic, aero=aero, mismatch=mismatch, noise=noise, candidates=cands,

@@ -307,6 +307,32 @@ def withhold_offset_of_a_scaled_vane(cands: list[Candidate], kin: KinematicResul
                      f"{refit.std_error_ft[0]:.2f} ft, largest |t| = {t:.1f})")
 
 
+# The two tests that size the accelerometer's x position: the force mismatch's fit
+# (:func:`stepwise_axes.offset_candidate`) and the kinematic check's (effects.md's sensor_offset).
+ACCELEROMETER_X = ("x_accelerometer", "offset_x")
+
+
+def name_accelerometer_once(cands: list[Candidate]) -> None:
+    """One accelerometer, one position: when both tests of :data:`ACCELEROMETER_X` name it,
+    the one at the larger |t| is kept and the other withheld, its size kept in the reason.
+    (An independent script's J-3 Cub, pitch 3-2-1-1, the accelerometer 4 ft ahead: the force
+    mismatch said 4.14 ± 0.25 ft and the kinematics, corroborated on the coefficients,
+    3.34 ± 0.31; both were named, as two findings.)"""
+    named = [c for c in cands if c.selected and c.parameter in ACCELEROMETER_X]
+    if len(named) < 2:
+        return
+    keep = max(named, key=lambda c: abs(c.t))
+    for c in named:
+        if c is keep:
+            continue
+        apart = abs(c.estimate - keep.estimate) / max(float(np.hypot(c.std_error, keep.std_error)), 1e-300)
+        c.selected = False
+        c.details["named_as"] = keep.parameter
+        c.reason = (f"not named again: the accelerometer's x position is named once, as {keep.parameter} "
+                    f"({keep.estimate:.2f} ± {keep.std_error:.2f} ft, t = {keep.t:.1f}); this test puts it at "
+                    f"{c.estimate:.2f} ± {c.std_error:.2f} ft ({apart:.1f} combined standard errors apart)")
+
+
 def kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, plausible: bool,
                          gusty: str = "") -> list[Candidate]:
     """The sensor candidates. The forced (nuisance) biases are tested one by one, not picked

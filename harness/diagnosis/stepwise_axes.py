@@ -250,12 +250,19 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     maneuver is otherwise indistinguishable from C_n,β. Refuted when the constant falls
     short of the prediction; then, if the constant is itself a shift of the prediction's sign
     (:data:`CG_MEAN_Z` standard errors from zero), that shift is the one to name: the stepwise
-    shared the C_Z column with terms that follow α (C_Z does), oversizing it."""
+    shared the C_Z column with terms that follow α (C_Z does), oversizing it. Only for a shift
+    C_m's stepwise entered: one read off C_n's C_Y column and refuted there stood in for a
+    C_n term, and C_m's constant beside it is the model's own mistrim as much as any shift
+    (an independent script's T-6 in a 20° turn, lateral multisine, C_n,β +0.03: C_n entered a
+    shift for it, and the 0.03 ft C_m's constant said was named beside the C_n,β change; the
+    same constant stands on the null, where C_n enters nothing)."""
     sel, by_key = selections[axis]
     if "cg" not in sel.names:
         return None
     test = shift_mistrim_test(p, sel.params["cg"] * by_key["cg"].scale, axis, selections, nuisances, mismatch,
                               measured)
+    if test is not None and test.pinned and axis != "Cm":
+        test = test._replace(pinned=False)
     if test is not None and test.pinned:
         test = test._replace(reason=test.reason + f", the mistrim of a {test.dx_ft:.3g} ± {test.std_error_ft:.2g} ft "
                                                   "shift, named instead")

@@ -926,7 +926,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             rival, t = found
             c.selected = False
             c.details["sensor_rival"] = rival
-            c.details["suspicion"] = {"parameter": rival, "t": t}
+            c.details["suspicion"] = _suspicion(rival, t, contest_at)
             c.reason = (f"entered, but not named: the {channel} sensor itself may be in error ({_named(rival)}, "
                         f"kinematic t = {t:.1f}), an error that would imitate this term")
     for c in cands:  # the sensors the coefficient itself is measured with
@@ -956,7 +956,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
         (rival, t), sensor = found
         c.selected = False
         c.details["sensor_rival"] = rival if isinstance(rival, str) else rival[0]
-        c.details["suspicion"] = {"parameter": c.details["sensor_rival"], "t": t}
+        c.details["suspicion"] = _suspicion(c.details["sensor_rival"], t, contest_at)
         if not isinstance(rival, str):
             c.details["sensor_rivals"] = list(rival)
         why = _measured_with(kin, rival, t, sensor)
@@ -978,6 +978,17 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             c.reason = (f"entered, but not named: the kinematics {read}, as a simulation integrating by "
                         f"rectangular Euler records them; the rates' derivatives, from which {c.channel} is built, "
                         "then lag the moments by as much, which imitates this term")
+
+
+def _suspicion(rival: str, t: float, contest_at: dict[str, tuple[float, float]]) -> dict:
+    """The suspicion that withheld a term: the suspect and its t, and, for a contested
+    suspect's rival brought in at its own estimate (:func:`withhold_ambiguous`), that estimate
+    and standard error (``at``), the size the suspicion was made at, which the kinematic fit
+    beside the contested suspect does not carry."""
+    out = {"parameter": rival, "t": t}
+    if rival in contest_at:
+        out["at"] = list(contest_at[rival])
+    return out
 
 
 def _measured_with(kin: KinematicResult, rival: str | tuple[str, ...], t: float, sensor: str) -> str:
