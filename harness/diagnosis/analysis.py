@@ -34,7 +34,8 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_explained_by_cg, withhold_explained_by_force_arm,
                                           withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
-                                          withhold_lateral_drift_off_the_vane, withhold_rivals)
+                                          withhold_lateral_drift_off_the_vane,
+                                          withhold_resting_on_an_uncertain_correction, withhold_rivals)
 from models.aircraft import Aircraft, has_propeller
 from models.replay import InitialCondition
 
@@ -116,6 +117,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
     imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
     withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin), contested)
+    withhold_resting_on_an_uncertain_correction(cands, kin, sensor_values, imitated)
     if turbulent:
         withhold_in_turbulence(cands)
     else:

@@ -213,7 +213,10 @@ def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.
     u, v, w = V * np.cos(a) * np.cos(b), V * np.sin(b), V * np.sin(a) * np.cos(b)
     P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
     h = ch.get("h")
-    g = G0 * (EARTH_RADIUS_FT / (EARTH_RADIUS_FT + (h if h is not None else 0.0))) ** 2
+    # gravity at the recorded altitude, else at its stand-in (prepare: the ISA altitude of the
+    # density); at sea level a 787-8 at 28,000 ft without h carried 0.087 ft/s² in ẇ
+    at = h if h is not None else getattr(p, "altitude", None)
+    g = G0 * (EARTH_RADIUS_FT / (EARTH_RADIUS_FT + (at if at is not None else 0.0))) ** 2
     D, F = p.differentiate, p.filt
     out = {
         "u": D(u) - F(R * v - Q * w - g * np.sin(th) + G0 * ch["ax"]),

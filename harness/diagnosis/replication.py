@@ -94,7 +94,12 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
     that cannot measure it (a large standard error) lifts nothing. Not when either record's
     kinematics are void (:func:`_kinematics_trusted`), nor when the coefficient mismatch
     itself reads the suspected vane scale (``details['shape']``,
-    :func:`sensor_naming.withhold_vane_scale`). The term is then judged on the validation
+    :func:`sensor_naming.withhold_vane_scale`), nor when another rival imitates the term too
+    (``details['also_imitated_by']``: the rates' derivatives lagging the moments by JSBSim's
+    Euler step; an independent script's T-6 null, 3-2-1-1 on each axis at 50 Hz, had a
+    C_m,q̂ 2.5 over the model's, t 11, withheld for an a_z scale the validation then ruled
+    out, and named, though the Euler lag, asked only of terms still selected, imitated it).
+    The term is then judged on the validation
     maneuver as any finding. (An F-16 at 330 ft/s, lateral,
     C_n,β +0.04: entered at t 11.7 and withheld for an r-gyro scale of 0.088 ± 0.028, kinematic
     t 3.2, which the validation maneuver put at −0.055 ± 0.022.)
@@ -105,7 +110,8 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
     lifted = []
     for c in a.candidates:
         suspicion = c.details.get("suspicion")
-        if c.selected or not suspicion or c.details.get("sensor_rival") != suspicion["parameter"]:
+        if (c.selected or not suspicion or c.details.get("sensor_rival") != suspicion["parameter"]
+                or "also_imitated_by" in c.details):
             continue
         name = suspicion["parameter"]
         if "shape" in getattr(by_name.get(name), "details", {}):

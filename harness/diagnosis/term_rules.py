@@ -16,10 +16,11 @@ from harness.diagnosis.along import (INERTIAL_CHANNELS, corrected_recording, ine
                                      rate_derivatives_advanced)
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import turbulence_test
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
 from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
 from harness.diagnosis.prepare import Prepared, clean_channels
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYRO_UNIT, GYROS, kinematic_estimate, kinematic_std_error,
-                                            suspected_estimate, unit_members)
+                                            kinematic_t, suspected_estimate, unit_members)
 from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test, vane_error_column
 from models.aircraft import Aircraft
 from models.constants import SURFACES
@@ -756,17 +757,56 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         sigma = abs(v) / t if t > 0 else np.inf
         return per_v * v * np.sign(change), IMITATION_Z * abs(per_v) * sigma
 
-    def imitated(c: Candidate, name: str | tuple[str, ...], at: tuple[float, float] | None = None) -> float | None:
+    def imitated(c: Candidate, name: str | tuple[str, ...], at: tuple[float, float] | None = None,
+                 applied: bool = False) -> float | None:
         """The most ``name`` imitates within IMITATION_Z standard errors (of ``at``, estimate
         and standard error, when given); for several errors at once (a tuple), within that
         many of their joint estimate (independent: the centres add, the half-widths in
-        quadrature)."""
+        quadrature). ``applied``: the error is already corrected for at its estimate, and
+        what counts is how much of the change moving that correction within IMITATION_Z
+        standard errors can take away (the half-width alone)."""
         names = (name,) if isinstance(name, str) else name
         parts = [part(c, n, at) for n in names]
         if any(x is None for x in parts):
             return None
-        return sum(x[0] for x in parts) + float(np.sqrt(sum(x[1] ** 2 for x in parts)))
+        spread = float(np.sqrt(sum(x[1] ** 2 for x in parts)))
+        return spread if applied else sum(x[0] for x in parts) + spread
     return imitated
+
+
+def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: KinematicResult,
+                                                applied: dict[str, float], imitated) -> None:
+    """Deselect coefficient terms that rest on a sensor correction the kinematics applied
+    without being sure of it: a value applied from |t| :data:`sensor_rules.APPLY_T` on but
+    below the kinematic entry t (:data:`kinematics.T_IN`), which moved within
+    :data:`IMITATION_Z` of its standard errors (zero among them) would take at least
+    :data:`IMITATION_SHARE` of the term's change away (``imitated(..., applied=True)``,
+    :func:`imitation`). An independent script's c182 (168 ft/s, doublets, 25 Hz) with p
+    40 ms late had an α bias of 0.52° applied at kinematic t 3.1 (the skew's doing, the skew
+    itself under its practical size); along the α so corrected the model's C_n,p̂, which
+    follows α, left a C_n,p̂ change of −0.018 (t −8.4), −0.003 without the correction."""
+    unsure = {n: v for n, v in applied.items() if kinematic_t(kin, n) < KIN_T_IN}
+    if imitated is None or not unsure:
+        return
+    for c in cands:
+        if not (c.selected and c.effect in ("coefficient_error", "unsteady_alphadot", "nonlinear_alpha",
+                                            "cross_coupling") and c.test.startswith("stepwise")):
+            continue
+        change = abs(term_change(c))
+        for name, v in unsure.items():
+            se = kinematic_std_error(kin, name)
+            size = imitated(c, name, (v, se), applied=True) if np.isfinite(se) and se > 0 else None
+            if size is None or size < IMITATION_SHARE * change:
+                continue
+            c.selected = False
+            c.details["sensor_rival"] = name
+            c.details["uncertain_correction"] = {"parameter": name, "applied": v, "std_error": se,
+                                                 "imitates_at_most": size, "change": change}
+            c.reason = (f"entered, but not named: it rests on the correction for {_named(name)} = {v:.3g} ± {se:.2g} "
+                        f"(kinematic t = {abs(v) / se:.1f}, applied though below the entry t); within "
+                        f"{IMITATION_Z:g} of its standard errors that correction takes {size:.2g} of this change "
+                        f"of {change:.3g} away")
+            break
 
 
 # The channels the α vane's error column is integrated from, beyond the gyros and the vane:
@@ -964,9 +1004,18 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     if euler_lag is None:
         return
     for c in cands:  # a simulation's integration step: the moments lead the rates' derivatives
-        if not (c.selected and c.channel in MOMENT_AXES and c.test.startswith("stepwise") and _lag_shaped(c)):
+        suspected = not c.selected and "suspicion" in c.details  # withheld above: asked too, for the lift
+        if not ((c.selected or suspected) and c.channel in MOMENT_AXES and c.test.startswith("stepwise")
+                and _lag_shaped(c)):
             continue
         lag = euler_lag
+        if suspected:
+            if explains(c, EULER_LAG, lag.t if lag.shown else 0.0):
+                c.details["also_imitated_by"] = EULER_LAG
+                c.details["euler_lag_s"] = [lag.tau, lag.std_error, lag.low, lag.high]
+                c.reason += ("; the rates' derivatives lagging the moments by a simulation's rectangular-Euler "
+                             "step would imitate it too")
+            continue
         if explains(c, EULER_LAG, lag.t if lag.shown else 0.0):
             c.selected = False
             c.details["sensor_rival"] = EULER_LAG
