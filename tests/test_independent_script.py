@@ -382,23 +382,41 @@ def test_a_late_roll_gyro_is_named_not_a_bank_skew_and_aileron_delay(tmp_path):
 
 
 def _package_xml(model: str) -> str:
+    """The package aircraft ``model``'s XML path, its surfaces registered with the script (the
+    elevator, left aileron and rudder positions, as the package's aircraft name them)."""
     import jsbsim
+
+    import independent_script
+    independent_script.SURFACE_PROPERTIES.setdefault(
+        model, ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
     return str(Path(jsbsim.get_default_root_dir()) / "aircraft" / model / f"{model}.xml")
+
+
+def _with_multisteps(monkeypatch) -> None:
+    """Teach the script the 3-2-1-1 inputs of :func:`_doublets_3211` (``3211_3`` on each axis,
+    ``3211_pitch`` on the stabilator alone)."""
+    import independent_script
+
+    def multisteps(kind, amplitude_rad, duration_s, rng):
+        if kind not in ("3211_3", "3211_pitch"):
+            return inputs(kind, amplitude_rad, duration_s, rng)
+        steps = _doublets_3211(kind, amplitude_rad, duration_s, rng)
+        return steps if kind == "3211_3" else {k: v * (k == "de") for k, v in steps.items()}
+    monkeypatch.setattr(independent_script, "inputs", multisteps)
 
 
 def test_a_yaw_stability_change_names_no_shift_from_the_pitching_moment_s_constant(tmp_path):
     """The package's T-6 (11,000 ft / 360 ft/s, lateral multisine at 40 Hz) with C_n,β 0.03
     higher in an XML copy: C_n's stepwise entered a moment-reference shift for it (its C_Y
     column follows β), which C_m's constant refuted, and that constant, the model's own
-    mistrim, was then taken as the shift and named first (0.064 ft, t 120). A shift is sized by C_m's constant
-    only when C_m's own stepwise entered it (stepwise_axes._cg_mean_test); C_n,β is named."""
-    import independent_script
-    independent_script.SURFACE_PROPERTIES.setdefault(
-        "t6texan2", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    mistrim, was then taken as the shift and named first (0.064 ft, t 120). A shift is sized
+    by C_m's constant only when C_m's own stepwise entered it (stepwise_axes._cg_mean_test);
+    C_n,β is named."""
+    model = _package_xml("t6texan2")
     root = _f16_with_extra_term(tmp_path / "root", "YAW", ("aero/qbar-psf", "metrics/Sw-sqft", "metrics/bw-ft",
                                                            "aero/beta-rad"), 0.03, model="t6texan2")
     rec = fly(tmp_path / "id.csv", "t6texan2", 11192.0, 359.2, 1, 40.0, "ms_lat", amplitude_deg=2.44, root=root)
-    result = diagnose(_package_xml("t6texan2"), rec, tmp_path / "out", calibrate=False)
+    result = diagnose(model, rec, tmp_path / "out", calibrate=False)
     assert [p for p, _ in _found(result)] == ["Cn_beta"]
     assert result["findings"][0]["evidence"]["change"] == pytest.approx(0.03, rel=0.25)
     assert not any(c["parameter"] == "dx_moment_reference" and c["selected"] for c in result["candidates"])
@@ -424,16 +442,13 @@ def test_a_sideslip_vane_bias_is_not_read_as_light_turbulence(tmp_path, monkeypa
     kinematics put at t 16 was not applied. Asked again on the channels corrected for the
     kinematics' biases (gust_biases.gusts_without_biases), the gusts are gone and the bias is
     named at its size."""
-    import independent_script
-    independent_script.SURFACE_PROPERTIES.setdefault(
-        "A4", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
-    monkeypatch.setattr(independent_script, "inputs",
-                        lambda kind, a, d, rng: (_doublets_3211 if kind == "3211_3" else inputs)(kind, a, d, rng))
+    model = _package_xml("A4")
+    _with_multisteps(monkeypatch)
     rec = fly(tmp_path / "id.csv", "A4", 10790.0, 538.7, 42, 50.0, "3211_3", units="deg", amplitude_deg=3.17)
     val = fly(tmp_path / "val.csv", "A4", 10790.0, 538.7, 50042, 50.0, "dbl3", units="deg", amplitude_deg=3.17)
     for path in (rec, val):
         _sensor_error(path, "beta_deg", lambda t, x: x + 1.0)
-    result = diagnose(_package_xml("A4"), rec, tmp_path / "out", val, calibrate=False)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
     found = _found(result)
     assert [p for p, _ in found] == ["bias_beta"] and np.degrees(found[0][1]) == pytest.approx(1.0, abs=0.1)
     gust = next(c for c in result["candidates"] if c["parameter"] == "sigma_gust_fps")
@@ -468,19 +483,15 @@ def test_an_accelerometer_ahead_of_the_cg_is_named_once(tmp_path, monkeypatch):
     mismatch put it at 4.14 ± 0.25 ft (x_accelerometer) and the kinematics, corroborated on
     the coefficients, at 3.34 ± 0.31 (offset_x); both were named, two findings of one
     position. It is named once (sensor_rules.name_accelerometer_once), at the larger t."""
-    import independent_script
-    independent_script.SURFACE_PROPERTIES.setdefault(
-        "J3Cub", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
-    monkeypatch.setattr(independent_script, "inputs", lambda kind, a, d, rng: (
-        {k: v * (k == "de") for k, v in _doublets_3211(kind, a, d, rng).items()} if kind == "3211_pitch"
-        else inputs(kind, a, d, rng)))
+    model = _package_xml("J3Cub")
+    _with_multisteps(monkeypatch)
     rec = fly(tmp_path / "id.csv", "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
               amplitude_deg=2.94)
     val = fly(tmp_path / "val.csv", "J3Cub", 1734.0, 117.9, 50158, 50.0, "dbl3", units="deg", noise=2.0,
               amplitude_deg=2.94)
     for path in (rec, val):
         _accelerometer_ahead(path, 4.0)
-    result = diagnose(_package_xml("J3Cub"), rec, tmp_path / "out", val, calibrate=False)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
     found = _found(result)
     assert [p for p, _ in found] == ["x_accelerometer"] and found[0][1] == pytest.approx(4.0, rel=0.25)
     twice = next(c for c in result["candidates"] if c["parameter"] == "offset_x")
@@ -505,15 +516,13 @@ def test_a_term_resting_on_an_uncertain_alpha_correction_is_not_named(tmp_path):
     change of −0.018 (t −8.4), −0.003 without the correction. A term that correction, moved
     within three of its standard errors, takes half of is withheld
     (term_rules.withhold_resting_on_an_uncertain_correction)."""
-    import independent_script
-    independent_script.SURFACE_PROPERTIES.setdefault(
-        "c182", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    model = _package_xml("c182")
     rec = fly(tmp_path / "id.csv", "c182", 5080.0, 168.2, 174, 25.0, "dbl3", noise=0.5, amplitude_deg=3.43)
     val = fly(tmp_path / "val.csv", "c182", 5080.0, 168.2, 50174, 25.0, "dbl3", noise=0.5, amplitude_deg=3.43)
     for path in (rec, val):
         _sensor_error(path, "p_rps", lambda t, x: np.interp(t - 0.04, t, x))
         _without_column(path, "h_ft")
-    result = diagnose(_package_xml("c182"), rec, tmp_path / "out", val, calibrate=False)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
     assert {p for p, _ in _found(result)} <= {"skew_p"}
     term = next(c for c in result["candidates"] if c["parameter"] == "Cn_phat")
     assert not term["selected"] and "rests on the correction for bias_alpha" in term["reason"], term["reason"]
@@ -526,14 +535,11 @@ def test_a_suspicion_lifted_leaves_a_term_another_rival_imitates_withheld(tmp_pa
     derivatives lagging the moments by JSBSim's Euler step imitate it too, but were asked only
     of terms still selected. Now asked of the suspected ones as well, and a term another rival
     imitates is not lifted (replication.lift_unreplicated_suspicions)."""
-    import independent_script
-    independent_script.SURFACE_PROPERTIES.setdefault(
-        "t6texan2", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
-    monkeypatch.setattr(independent_script, "inputs",
-                        lambda kind, a, d, rng: (_doublets_3211 if kind == "3211_3" else inputs)(kind, a, d, rng))
+    model = _package_xml("t6texan2")
+    _with_multisteps(monkeypatch)
     rec = fly(tmp_path / "id.csv", "t6texan2", 11639.0, 408.2, 2, 50.0, "3211_3", units="deg", amplitude_deg=3.23)
     val = fly(tmp_path / "val.csv", "t6texan2", 11639.0, 408.2, 50002, 50.0, "dbl3", units="deg", amplitude_deg=3.23)
-    result = diagnose(_package_xml("t6texan2"), rec, tmp_path / "out", val, calibrate=False)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
     assert _found(result) == []
     term = next(c for c in result["candidates"] if c["parameter"] == "Cm_qhat")
     assert not term["selected"] and "would imitate it too" in term["reason"], term["reason"]
@@ -547,13 +553,11 @@ def test_the_air_share_does_not_take_an_undriven_vane_as_a_nuisance(tmp_path):
     (1.09 ± 0.11 in a 42° turn) and turbulence of 3.2 ft/s was named, here as there. An angle
     the maneuver neither drove nor moved is no nuisance there (gust_rules.air_share_test): the
     share is 0.04 ± 0.03, vane error, and nothing is named."""
-    import independent_script
-    independent_script.SURFACE_PROPERTIES.setdefault(
-        "787-8", ("fcs/elevator-pos-rad", "fcs/left-aileron-pos-rad", "fcs/rudder-pos-rad"))
+    model = _package_xml("787-8")
     rec = fly(tmp_path / "id.csv", "787-8", 28031.0, 838.3, 249, 50.0, "ms_lat", units="deg", noise=2.0,
               amplitude_deg=2.64)
     _without_column(rec, "h_ft")
-    result = diagnose(_package_xml("787-8"), rec, tmp_path / "out", calibrate=False)
+    result = diagnose(model, rec, tmp_path / "out", calibrate=False)
     assert _found(result) == []
     gust = next(c for c in result["candidates"] if c["parameter"] == "sigma_gust_fps")
     import re

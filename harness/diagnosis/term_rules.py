@@ -779,7 +779,7 @@ def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: Kin
     """Deselect coefficient terms that rest on a sensor correction the kinematics applied
     without being sure of it: a value applied from |t| :data:`sensor_rules.APPLY_T` on but
     below the kinematic entry t (:data:`kinematics.T_IN`), which moved within
-    :data:`IMITATION_Z` of its standard errors (zero among them) would take at least
+    :data:`IMITATION_Z` of its standard errors would take at least
     :data:`IMITATION_SHARE` of the term's change away (``imitated(..., applied=True)``,
     :func:`imitation`). An independent script's c182 (168 ft/s, doublets, 25 Hz) with p
     40 ms late had an α bias of 0.52° applied at kinematic t 3.1 (the skew's doing, the skew
