@@ -214,7 +214,8 @@ def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.
     P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
     h = ch.get("h")
     # gravity at the recorded altitude, else at its stand-in (prepare: the ISA altitude of the
-    # density); at sea level a 787-8 at 28,000 ft without h carried 0.087 ft/s² in ẇ
+    # density): at sea level's, the outside sweep's F-16 at 25,000 ft without h read its
+    # 0.04 g a_z bias as 0.04376 (now 0.04139): gravity there is 0.24 % less
     at = h if h is not None else getattr(p, "altitude", None)
     g = G0 * (EARTH_RADIUS_FT / (EARTH_RADIUS_FT + (at if at is not None else 0.0))) ** 2
     D, F = p.differentiate, p.filt
