@@ -400,8 +400,9 @@ def test_a_sensor_suspicion_the_validation_maneuver_does_not_share_is_lifted(mon
     again when the validation maneuver's kinematics put that scale at −0.055 ± 0.022 (4.0
     combined standard errors apart; a suspicion of the other sign there). A validation
     estimate of the same sign that is a suspicion itself, one within two standard errors, one
-    the validation maneuver cannot measure, a term withheld for another reason, or a scale the
-    coefficient mismatch itself reads (details['shape']) lift nothing."""
+    the validation maneuver cannot measure, a term withheld for another reason, a scale the
+    coefficient mismatch itself reads (details['shape']), or a suspicion at the kinematic
+    entry t or above lift nothing."""
     from types import SimpleNamespace
 
     from harness.diagnosis import replication
@@ -434,6 +435,9 @@ def test_a_sensor_suspicion_the_validation_maneuver_does_not_share_is_lifted(mon
         assert lift_unreplicated_suspicions(a, SimpleNamespace(kinematic=there)) == [] and not a.candidates[0].selected
     for a in (identification(details={"sensor_rival": "scale_r"}), identification(shape=True)):
         assert lift_unreplicated_suspicions(a, SimpleNamespace(kinematic=kin(-0.0548, 2.52))) == []
+    strong = identification()          # at the kinematic entry t or above: no suspicion a null makes
+    strong.kinematic = kin(0.088, 6.5)
+    assert lift_unreplicated_suspicions(strong, SimpleNamespace(kinematic=kin(-0.0548, 2.52))) == []
 
 
 def test_a_suspicion_made_at_a_size_of_its_own_is_compared_at_that_size(monkeypatch):

@@ -99,7 +99,10 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
     Euler step; an independent script's T-6 null, 3-2-1-1 on each axis at 50 Hz, had a
     C_m,q̂ 2.5 over the model's, t 11, withheld for an a_z scale the validation then ruled
     out, and named, though the Euler lag, asked only of terms still selected, imitated it).
-    The term is then judged on the validation
+    Only a suspicion below the kinematic entry t (:data:`kinematics.T_IN`) is lifted: one at
+    or above it is no suspicion of the size nulls make (a c172p in a 41° turn at 100 Hz with
+    a_z 40 ms late: the skew at t 10, 40.6 ± 4 ms, withheld a C_Z,q̂ change of +14, which the
+    validation doublets' −29 ± 21 ms lifted). The term is then judged on the validation
     maneuver as any finding. (An F-16 at 330 ft/s, lateral,
     C_n,β +0.04: entered at t 11.7 and withheld for an r-gyro scale of 0.088 ± 0.028, kinematic
     t 3.2, which the validation maneuver put at −0.055 ± 0.022.)
@@ -117,7 +120,8 @@ def lift_unreplicated_suspicions(a: Analysis, av: Analysis) -> list[Candidate]:
         if "shape" in getattr(by_name.get(name), "details", {}):
             continue
         here, there = _suspected_at(a, suspicion), suspected_estimate(av.kinematic, name)
-        if here is None or there is None or (there[1] >= AMBIGUOUS_T and np.sign(there[0]) == np.sign(here[0])):
+        if (here is None or there is None or here[1] >= KIN_T_IN
+                or (there[1] >= AMBIGUOUS_T and np.sign(there[0]) == np.sign(here[0]))):
             continue
         se_here, se_there = here[2], there[2]
         apart = float(np.hypot(se_here, se_there))
