@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from harness.diagnosis.run import diagnose
-from independent_script import fly, inputs
+from independent_script import G0, fly, inputs
 
 
 def _found(result):
@@ -469,8 +469,8 @@ def _accelerometer_ahead(path, x_ft: float) -> None:
     window = max(int(round(0.2 / dt)) | 1, 5)
     qdot, rdot = (savgol_filter(np.radians(X[:, head.index(c)]), window, 3, deriv=1, delta=dt)
                   for c in ("q_dps", "r_dps"))
-    X[:, head.index("az_g")] -= x_ft * qdot / 32.174
-    X[:, head.index("ay_g")] += x_ft * rdot / 32.174
+    X[:, head.index("az_g")] -= x_ft * qdot / G0
+    X[:, head.index("ay_g")] += x_ft * rdot / G0
     with open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(head)

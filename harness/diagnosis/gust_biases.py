@@ -6,9 +6,8 @@ w equation (−p·v), and its integral follows the bank the maneuver rolled thro
 corrected for the constant errors the kinematics find, and the recording is judged by that."""
 from __future__ import annotations
 
-import numpy as np
-
 from harness.diagnosis.along import corrected_recording
+from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import light_gusts, turbulence_test
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
 from harness.diagnosis.kinematics import KinematicResult, is_plausible
@@ -42,7 +41,7 @@ def gusts_without_biases(p: Prepared, kin: KinematicResult, V0: float) -> tuple[
     return gust, biases
 
 
-def note_gusts_of_biases(cands: list, raw: GustEstimate, biases: dict[str, float]) -> None:
+def note_gusts_of_biases(cands: list[Candidate], raw: GustEstimate, biases: dict[str, float]) -> None:
     """Say, on the turbulence candidate, that the gust the raw channels gave was the biases'
     (:func:`gusts_without_biases`)."""
     for c in cands:
