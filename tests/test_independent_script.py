@@ -563,3 +563,93 @@ def test_the_air_share_does_not_take_an_undriven_vane_as_a_nuisance(tmp_path):
     import re
     share = float(re.search(r"air share (-?[0-9.]+)", gust["reason"]).group(1))
     assert not gust["selected"] and share < 0.5, gust["reason"]
+
+
+def _in_a_turn(monkeypatch, bank_deg: float) -> None:
+    """Trim the script's aircraft in a steady turn at ``bank_deg`` (JSBSim's turn trim) after its
+    wings-level trim."""
+    import independent_script
+    level = independent_script.trimmed
+
+    def banked(*args, **kwargs):
+        fdm = level(*args, **kwargs)
+        fdm["ic/phi-deg"] = bank_deg
+        fdm.run_ic()
+        fdm.do_trim(5)
+        return fdm
+    monkeypatch.setattr(independent_script, "trimmed", banked)
+
+
+def _with_pitch_sweep(monkeypatch) -> None:
+    """Teach the script ``sweep_pitch``: a linear stabilator sweep, 0.1 to 2 Hz over 20 s from
+    1 s, at 0.6 of the amplitude."""
+    import independent_script
+
+    def sweep(kind, amplitude_rad, duration_s, rng):
+        if kind != "sweep_pitch":
+            return inputs(kind, amplitude_rad, duration_s, rng)
+        t = np.arange(0.0, duration_s, 0.01)
+        tt = t - 1.0
+        u = np.where((tt >= 0) & (tt < 20.0), np.sin(2 * np.pi * (0.1 * tt + 0.5 * 1.9 / 20.0 * tt ** 2)), 0.0)
+        return {"de": 0.6 * amplitude_rad * u, "da": 0.0 * t, "dr": 0.0 * t}
+    monkeypatch.setattr(independent_script, "inputs", sweep)
+
+
+def test_a_force_term_the_accelerometer_position_leaves_is_not_named(tmp_path, monkeypatch):
+    """The package's c172x (4,560 ft / 186 ft/s, a stabilator sweep at 25 Hz in a 22° turn, half
+    the noise, doublet validation) with its accelerometer 4 ft ahead of the c.g.: the force
+    mismatch put the position at 2.45 ± 0.34 ft, and what that left in C_Z, following q̇,
+    entered C_Z's stepwise as a C_Z,α̇ change of +6.3 (t −11.4), named first. Fitted beside the
+    position on the three force mismatches together it stands at t −2.0
+    (accelerometer_rules.withhold_beside_the_accelerometer): the position alone is named."""
+    model = _package_xml("c172x")
+    _in_a_turn(monkeypatch, -22.0)
+    _with_pitch_sweep(monkeypatch)
+    rec = fly(tmp_path / "id.csv", "c172x", 4560.0, 186.5, 158, 25.0, "sweep_pitch", units="deg", noise=0.5,
+              amplitude_deg=5.15)
+    val = fly(tmp_path / "val.csv", "c172x", 4560.0, 186.5, 50158, 25.0, "dbl3", units="deg", noise=0.5,
+              amplitude_deg=5.15)
+    for path in (rec, val):
+        _accelerometer_ahead(path, 4.0)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert [p for p, _ in _found(result)] in (["x_accelerometer"], ["offset_x"])
+    term = next(c for c in result["candidates"] if c["parameter"] == "CZ_alphadot")
+    assert not term["selected"]
+
+
+def test_an_accelerometer_position_the_force_mismatch_undoes_is_not_applied(tmp_path):
+    """The package's c172x (4,713 ft / 196 ft/s, doublets at 100 Hz, 5.5°, half the noise, no
+    validation maneuver): the kinematics put the accelerometer 1.15 ft aft (t −8.4, the gyros'
+    few milliseconds of timing), under its practical size, and applied it; along the a_y so
+    corrected, x·ṙ in C_Y, the force mismatch asked for +1.12 ft (t 23) and C_Y,β, C_Y,δr and
+    C_Y,r̂ changes were named (t 48, −20, −10). A position the force mismatch undoes is taken
+    back (accelerometer_rules.refuted_positions): nothing is named (−1.07 ft applied, +1.08 asked
+    back at t 17.9 as this script writes the recording)."""
+    model = _package_xml("c172x")
+    rec = fly(tmp_path / "id.csv", "c172x", 4713.0, 196.3, 141, 100.0, "dbl3", noise=0.5, amplitude_deg=5.51)
+    result = diagnose(model, rec, tmp_path / "out", calibrate=False)
+    assert _found(result) == []
+    offset = next(c for c in result["candidates"] if c["parameter"] == "offset_x")
+    assert offset["reason"].startswith("not applied or named"), offset["reason"]
+
+
+def test_an_alpha_bias_without_the_flight_path_needs_the_kinematic_entry_t(tmp_path, monkeypatch):
+    """The package's c172p (3,968 ft / 184 ft/s, 3-2-1-1 on each axis at 25 Hz, half the noise,
+    no h channel, doublet validation) with q 40 ms late: the skew (one sample) is under its
+    practical size, and the α-vane bias fitted beside it, 0.56° at t 5.3, was named (0.55° at
+    t 4.5 without the skew, 0.24° at t 3.7 with h). Without h no flight-path equation ties α
+    to the attitude, and an α bias reaches the kinematic residuals only through q·u and q·w:
+    it takes the kinematic entry t of 6 (sensor_rules.forced_entry_t); nothing is named."""
+    model = _package_xml("c172p")
+    _with_multisteps(monkeypatch)
+    rec = fly(tmp_path / "id.csv", "c172p", 3968.0, 183.9, 240, 25.0, "3211_3", units="deg", noise=0.5,
+              amplitude_deg=2.43)
+    val = fly(tmp_path / "val.csv", "c172p", 3968.0, 183.9, 50240, 25.0, "dbl3", units="deg", noise=0.5,
+              amplitude_deg=2.43)
+    for path in (rec, val):
+        _sensor_error(path, "q_dps", lambda t, x: np.interp(t - 0.04, t, x))
+        _without_column(path, "h_ft")
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert {p for p, _ in _found(result)} <= {"skew_q"}
+    bias = next(c for c in result["candidates"] if c["parameter"] == "bias_alpha")
+    assert not bias["selected"]

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from harness.diagnosis.along import corrected_recording, inertial_beta, model_along, slope_function
+from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refuted_positions,
+                                                   withhold_beside_the_accelerometer)
+from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
 from harness.diagnosis.gust_biases import gusts_without_biases, note_gusts_of_biases
@@ -12,6 +14,7 @@ from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_tes
                                           spectral_candidates, turbulence_test, vane_wander, withhold_in_light_gusts,
                                           withhold_in_turbulence, withhold_vane_wander)
 from harness.diagnosis.gusts import process_noise_model
+from harness.diagnosis.kinematics import KinematicResult
 from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, name_applied, name_corroborated,
                                              name_vane_bias_from_means, signature_ratios,
@@ -52,6 +55,24 @@ def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str,
     return out
 
 
+def _along_corrected(recorded: Prepared, kin: KinematicResult, values: dict[str, float], aircraft: Aircraft,
+                     ic: InitialCondition) -> tuple[Prepared, ModelAlong, dict[str, dict]]:
+    """The recording corrected for the sensor ``values``, the model along it, and the
+    accelerometer position components the force mismatch there refutes
+    (:func:`accelerometer_rules.refuted_positions`): those are taken out of ``values`` (in
+    place) and the correction and the model made again without them."""
+    p = corrected_recording(recorded, kin, values)
+    along = model_along(p, aircraft, ic)
+    mismatch = along.mismatch()
+    refuted = refuted_positions(p, mismatch, coefficient_noise(p, mismatch), values)
+    if refuted:
+        for name in refuted:
+            values.pop(name)
+        p = corrected_recording(recorded, kin, values)
+        along = model_along(p, aircraft, ic)
+    return p, along, refuted
+
+
 def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     """Run every test on recording ``p`` against ``aircraft`` (module docstring)."""
     # 0. turbulence first: gusts make air-relative and inertial velocities differ, which
@@ -70,9 +91,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     contested = contested_parameters(kin, p)
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
                      if n not in contested and steady_vane(n, p) is None}
-    recorded, p = p, corrected_recording(p, kin, sensor_values)
     # 2. the model along the measured states
-    along = model_along(p, aircraft, ic)
+    recorded, (p, along, refuted) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along[:5]
     mismatch = along.mismatch()
     slope_of = slope_function(aircraft, ic, states, surfaces, alphadot, aero)
@@ -82,6 +102,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
     cands = kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
     withhold_biases_an_airspeed_bias_makes(cands, kin)
+    note_refuted_positions(cands, refuted)
     noise = coefficient_noise(p, mismatch)
     # 3. accelerometer position from the force mismatches (removed from them when named)
     as_evaluated = dict(mismatch)
@@ -100,6 +121,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     if step.pinned is not None:
         cands.append(pinned_shift(step.pinned, p, aero.trim))
     withhold_on_moving_throttle(cands, p, propeller)
+    withhold_beside_the_accelerometer(cands, step.selections, p, as_evaluated, noise)
     # the rules that keep a term from being named when something else would imitate it
     withhold_explained_by_cg(cands, step.selections, mismatch, p)
     withhold_explained_by_lift(cands, step.selections, mismatch, p)

@@ -335,7 +335,7 @@ class OffsetTest:
 FORCE_AXES = ("CX", "CY", "CZ")
 
 
-def _stacked_forces(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]):
+def stacked_forces(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]):
     """The force mismatches' interiors stacked and noise-weighted, the accelerometer
     position's columns stacked alike (per component), and an intercept per axis."""
     cols = accelerometer_columns(p)
@@ -350,7 +350,7 @@ def _stacked_forces(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[st
 def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]) -> OffsetTest:
     """Least squares of the stacked, noise-weighted force mismatches on the accelerometer
     position (with an intercept per axis), colored-residual standard errors."""
-    Z, X, I = _stacked_forces(p, mismatch, noise)
+    Z, X, I = stacked_forces(p, mismatch, noise)
     X = [X[a] for a in "xyz"]
     keep = [i for i in range(3) if np.ptp(X[i]) > 1e-12]
     theta, se, resid = colored_fit(Z, [X[i] for i in keep] + I, [f"r{i}" for i in keep] + list(FORCE_AXES),
@@ -410,7 +410,7 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
     k = int(np.argmax(np.abs(off.t)))
     if not np.isfinite(off.std_error_ft[k]):
         return None
-    Z, X, I = _stacked_forces(p, mismatch, noise)
+    Z, X, I = stacked_forces(p, mismatch, noise)
     inner = interior_slice(p.n, p.dt)
     m, axes = inner.stop - inner.start, FORCE_AXES
     keep = [a for a in "xyz" if np.ptp(X[a]) > 1e-12]

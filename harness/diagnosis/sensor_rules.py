@@ -343,7 +343,10 @@ def kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, pla
         sp = kin.parameters[name]
         est, se = kin.selection.params[name], kin.selection.std_errors[name]
         t = est / se if se > 0 else 0.0
-        sel, reason = sensor_verdict(name, est, se, abs(t) >= cand.T_IN, kin, p, turbulent, plausible, gusty)
+        entry = forced_entry_t(name, p)
+        sel, reason = sensor_verdict(name, est, se, abs(t) >= entry, kin, p, turbulent, plausible, gusty)
+        if reason == "below the entry t" and entry > cand.T_IN:
+            reason = f"below the entry t ({entry:g}: {NO_FLIGHT_PATH})"
         out.append(Candidate(sp.effect, None, sp.channel, name, est, se, t, 0.0, sp.units,
                              "kinematic consistency (bias always fitted)", sel, reason))
     for term in kin.selection.terms:
@@ -353,6 +356,21 @@ def kinematic_candidates(kin: KinematicResult, p: Prepared, turbulent: bool, pla
         out.append(Candidate(sp.effect, None, sp.channel, term.name, term.estimate, term.std_error, term.t, term.gain,
                              sp.units, "kinematic consistency", sel, reason))
     return out
+
+
+def forced_entry_t(name: str, p: Prepared) -> float:
+    """The entry t of a forced (nuisance) kinematic bias: the aerodynamic one
+    (:data:`candidates.T_IN`), except the α vane's without an h channel, which takes the
+    kinematic selection's (:data:`kinematics.T_IN`). The flight-path equation, ḣ against
+    u sinθ − w cosφ cosθ, ties α to the attitude; without it an α bias reaches the residuals
+    only through q·u and q·w, the columns of a pitch-rate skew or scale. An independent
+    script's c172p (4,000 ft / 170 ft/s, 3-2-1-1 on each axis at 25 Hz, no h) read a 0.56° α
+    bias at t 5.3 beside a one-sample q skew, 0.55° at t 4.5 on its null (0.24° at t 3.7
+    with h)."""
+    return KIN_T_IN if name == "bias_alpha" and "h" not in p.raw else cand.T_IN
+
+
+NO_FLIGHT_PATH = "no h channel, so no flight-path equation ties α to the attitude"
 
 
 def withhold_biases_an_airspeed_bias_makes(cands: list[Candidate], kin: KinematicResult) -> None:

@@ -1,0 +1,123 @@
+"""The accelerometer position against the force mismatches: a position the kinematics
+applied that the force mismatch along the corrected channels asks to undo is taken back; a
+term the stepwise fits entered after a named position was taken out must stand beside the
+position in the position's own fit, or it is the part of the position the fit did not size."""
+from __future__ import annotations
+
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.prepare import Prepared, interior_slice
+
+__all__ = ["KINEMATIC_POSITIONS", "note_refuted_positions", "refuted_positions", "term_beside_the_position",
+           "withhold_beside_the_accelerometer"]
+
+
+# The kinematic check's accelerometer position components (effects.md's sensor_offset).
+KINEMATIC_POSITIONS = ("offset_x", "offset_y", "offset_z")
+
+# A position applied from the kinematics is refuted when the force mismatch along the
+# corrected channels puts the accelerometer back, at the entry t, by at least this share of it.
+REFUTED_SHARE = 0.5
+
+
+def refuted_positions(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                      applied: dict[str, float]) -> dict[str, dict]:
+    """The accelerometer position components the kinematics applied (``applied``, ft) that the
+    force mismatch along the channels so corrected (``mismatch``) refutes: its own fit of the
+    position (:func:`candidates.accelerometer_offset`) puts that component back, opposite in
+    sign, at |t| >= the entry t (:data:`candidates.T_IN`) and at least :data:`REFUTED_SHARE`
+    of the applied size. The kinematics size the position from a_y and a_z against the rates'
+    derivatives, where a few milliseconds of the gyros' timing read as a position too; the
+    force mismatch sizes it against the aerodynamics. An independent script's c172x (196 ft/s,
+    doublets at 100 Hz, half the noise) had −1.15 ft applied (kinematic t −8.4, p and r 4-5 ms
+    early, t −9 and −6): along the a_y so corrected, x·ṙ in C_Y, the force mismatch asked for
+    +1.12 ft (t 23) and C_Y,β, C_Y,δr and C_Y,r̂ changes were named (t 48, −20, −10)."""
+    names = [n for n in applied if n in KINEMATIC_POSITIONS]
+    if not names:
+        return {}
+    off = cand.accelerometer_offset(p, mismatch, noise)
+    out = {}
+    for name in names:
+        k = "xyz".index(name[-1])
+        value, x, t = applied[name], off.position_ft[k], off.t[k]
+        if abs(t) >= cand.T_IN and np.sign(x) == -np.sign(value) and abs(x) >= REFUTED_SHARE * abs(value):
+            out[name] = {"applied_ft": float(value), "force_mismatch_ft": float(x),
+                         "std_error_ft": float(off.std_error_ft[k]), "t": float(t)}
+    return out
+
+
+def note_refuted_positions(cands: list[Candidate], refuted: dict[str, dict]) -> None:
+    """Say on each kinematic position component :func:`refuted_positions` took back that it
+    was not applied, and why; a named one is withheld."""
+    for c in cands:
+        r = refuted.get(c.parameter)
+        if r is None or not c.test.startswith("kinematic"):
+            continue
+        c.details["refuted_by_force_mismatch"] = r
+        c.selected = False
+        c.reason = (f"not applied or named: along the channels corrected for it ({r['applied_ft']:+.2f} ft) the "
+                    f"force mismatch puts the accelerometer back by {r['force_mismatch_ft']:+.2f} ± "
+                    f"{r['std_error_ft']:.2f} ft (t = {r['t']:.1f}); the kinematics' position is the gyros' timing, "
+                    "not the aerodynamics'")
+
+
+def term_beside_the_position(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                             axis: str, column: np.ndarray) -> tuple[float, float]:
+    """The t of one force-axis term fitted together with the accelerometer position on the
+    stacked, noise-weighted force mismatches (:func:`candidates.accelerometer_offset`'s fit,
+    one column more: the term's, on its own axis), and the position's x there (ft).
+    ``mismatch`` is the force mismatch as evaluated, the position not taken out."""
+    Z, X, I = cand.stacked_forces(p, mismatch, noise)
+    inner = interior_slice(p.n, p.dt)
+    m = inner.stop - inner.start
+    col = np.concatenate([column[inner] / noise[c] if c == axis else np.zeros(m) for c in cand.FORCE_AXES])
+    keep = [a for a in "xyz" if np.ptp(X[a]) > 1e-12]
+    theta, se, _ = colored_fit(Z, [X[a] for a in keep] + I + [col], keep + list(cand.FORCE_AXES) + ["term"],
+                               constant=False)
+    x = float(theta[keep.index("x")]) if "x" in keep else 0.0
+    return (float(theta[-1] / se[-1]) if se[-1] > 0 else 0.0), x
+
+
+def _term_column(selections: dict, c: Candidate) -> np.ndarray | None:
+    entry = selections.get(c.channel)
+    if entry is None:
+        return None
+    return next((term.column for term in entry[1].values() if term.parameter == c.parameter), None)
+
+
+def withhold_beside_the_accelerometer(cands: list[Candidate], selections: dict, p: Prepared,
+                                      mismatch: dict[str, np.ndarray], noise: dict[str, float]) -> None:
+    """Deselect a force-axis term (C_X, C_Y, C_Z) that the stepwise entered after a named
+    accelerometer position was taken out of the force mismatch, when beside the position, in
+    the position's own fit of the three force mismatches (:func:`term_beside_the_position`),
+    it falls below the entry t (:data:`candidates.T_IN`). The position is sized by a fit
+    without the term; what it leaves follows q̇ (and ṗ, ṙ), which a rate or α̇ term imitates.
+    An independent script's c172x (186 ft/s, pitch sweep, 25 Hz, 22° bank) with the
+    accelerometer 4 ft ahead had the position named at 2.45 ± 0.34 ft and, ahead of it, a
+    C_Z,α̇ change of +6.3 (t −11.4) that stood at t −2.0 beside it. ``mismatch`` is the
+    force mismatch as evaluated, before the position's columns were taken out."""
+    if not any(c.selected and c.parameter == "x_accelerometer" for c in cands):
+        return
+    for c in cands:
+        if not (c.selected and c.channel in cand.FORCE_AXES and c.test.startswith("stepwise")):
+            continue
+        column = _term_column(selections, c)
+        if column is None:
+            continue
+        try:
+            t, x = term_beside_the_position(p, mismatch, noise, c.channel, column)
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            continue
+        c.details["beside_the_position"] = {"t": t, "x_ft": x}
+        if abs(t) >= cand.T_IN:
+            continue
+        c.selected = False
+        c.details["sensor_rival"] = "x_accelerometer"
+        c.reason = (f"entered after the named accelerometer position was taken out of the force mismatch, but "
+                    f"fitted beside the position (x = {x:.2f} ft) on the three force mismatches together it stands "
+                    f"at t = {t:.1f}, under the entry t of {cand.T_IN:g}: it is the part of the position that fit "
+                    "left")
