@@ -580,19 +580,26 @@ def _in_a_turn(monkeypatch, bank_deg: float) -> None:
     monkeypatch.setattr(independent_script, "trimmed", banked)
 
 
-def _with_pitch_sweep(monkeypatch) -> None:
-    """Teach the script ``sweep_pitch``: a linear stabilator sweep, 0.1 to 2 Hz over 20 s from
-    1 s, at 0.6 of the amplitude."""
+def _with_sweeps(monkeypatch) -> None:
+    """Teach the script linear sweeps, 0.1 to 2 Hz: ``sweep_pitch`` on the stabilator (20 s from
+    1 s, 0.6 of the amplitude), ``sweep_lat`` on the aileron (11 s from 1 s) then the rudder
+    (11 s from 13 s), each at 0.8 of it."""
     import independent_script
 
-    def sweep(kind, amplitude_rad, duration_s, rng):
-        if kind != "sweep_pitch":
+    def sweeps(kind, amplitude_rad, duration_s, rng):
+        if kind not in ("sweep_pitch", "sweep_lat"):
             return inputs(kind, amplitude_rad, duration_s, rng)
         t = np.arange(0.0, duration_s, 0.01)
-        tt = t - 1.0
-        u = np.where((tt >= 0) & (tt < 20.0), np.sin(2 * np.pi * (0.1 * tt + 0.5 * 1.9 / 20.0 * tt ** 2)), 0.0)
-        return {"de": 0.6 * amplitude_rad * u, "da": 0.0 * t, "dr": 0.0 * t}
-    monkeypatch.setattr(independent_script, "inputs", sweep)
+
+        def chirp(t0, length):
+            tt = t - t0
+            return np.where((tt >= 0) & (tt < length),
+                            np.sin(2 * np.pi * (0.1 * tt + 0.5 * 1.9 / length * tt ** 2)), 0.0)
+        if kind == "sweep_pitch":
+            return {"de": 0.6 * amplitude_rad * chirp(1.0, 20.0), "da": 0.0 * t, "dr": 0.0 * t}
+        return {"de": 0.0 * t, "da": 0.8 * amplitude_rad * chirp(1.0, 11.0),
+                "dr": 0.8 * amplitude_rad * chirp(13.0, 11.0)}
+    monkeypatch.setattr(independent_script, "inputs", sweeps)
 
 
 def test_a_force_term_the_accelerometer_position_leaves_is_not_named(tmp_path, monkeypatch):
@@ -604,7 +611,7 @@ def test_a_force_term_the_accelerometer_position_leaves_is_not_named(tmp_path, m
     (accelerometer_rules.withhold_beside_the_accelerometer): the position alone is named."""
     model = _package_xml("c172x")
     _in_a_turn(monkeypatch, -22.0)
-    _with_pitch_sweep(monkeypatch)
+    _with_sweeps(monkeypatch)
     rec = fly(tmp_path / "id.csv", "c172x", 4560.0, 186.5, 158, 25.0, "sweep_pitch", units="deg", noise=0.5,
               amplitude_deg=5.15)
     val = fly(tmp_path / "val.csv", "c172x", 4560.0, 186.5, 50158, 25.0, "dbl3", units="deg", noise=0.5,
@@ -653,3 +660,24 @@ def test_an_alpha_bias_without_the_flight_path_needs_the_kinematic_entry_t(tmp_p
     assert {p for p, _ in _found(result)} <= {"skew_q"}
     bias = next(c for c in result["candidates"] if c["parameter"] == "bias_alpha")
     assert not bias["selected"]
+
+
+def test_a_rate_derivative_an_airspeed_bias_would_imitate_is_not_named(tmp_path, monkeypatch):
+    """The package's pa28 (2,928 ft / 154 ft/s, a lateral sweep at 50 Hz, half the noise,
+    doublet validation) with its airspeed 10 ft/s high: the model normalises p by the high V,
+    and a C_l,p̂ change of −0.026 on −0.47 was named (t −17); the kinematics, on a maneuver
+    that hardly moves V, put the bias at −3.2 ± 4.8 ft/s. Within three of those standard
+    errors a V bias imitates the whole change (airspeed_rules.withhold_on_the_airspeed):
+    nothing is named."""
+    model = _package_xml("pa28")
+    _with_sweeps(monkeypatch)
+    rec = fly(tmp_path / "id.csv", "pa28", 2928.0, 153.7, 299, 50.0, "sweep_lat", units="deg", noise=0.5,
+              amplitude_deg=3.45)
+    val = fly(tmp_path / "val.csv", "pa28", 2928.0, 153.7, 50299, 50.0, "dbl3", units="deg", noise=0.5,
+              amplitude_deg=3.45)
+    for path in (rec, val):
+        _sensor_error(path, "V_fps", lambda t, x: x + 10.0)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert {p for p, _ in _found(result)} <= {"bias_V"}
+    term = next(c for c in result["candidates"] if c["parameter"] == "Cl_phat")
+    assert not term["selected"] and "airspeed" in term["reason"], term["reason"]

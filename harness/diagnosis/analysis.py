@@ -6,6 +6,7 @@ import numpy as np
 
 from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refuted_positions,
                                                    withhold_beside_the_accelerometer)
+from harness.diagnosis.airspeed_rules import withhold_on_the_airspeed
 from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
@@ -140,6 +141,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
     withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin), contested)
     withhold_resting_on_an_uncertain_correction(cands, kin, sensor_values, imitated)
+    withhold_on_the_airspeed(cands, kin, imitated)
     if turbulent:
         withhold_in_turbulence(cands)
     else:
