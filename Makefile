@@ -15,8 +15,9 @@ $(STAMP): pyproject.toml requirements.lock
 demo: $(STAMP)
 	$(BIN)/sidbench demo --out out
 
+# Both cores: each test file on one worker (its module fixtures made once), files shared out.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist loadfile
 
 bench: $(STAMP)
 	$(BIN)/sidbench bench
