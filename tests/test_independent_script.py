@@ -381,6 +381,14 @@ def test_a_late_roll_gyro_is_named_not_a_bank_skew_and_aileron_delay(tmp_path):
     assert [p for p, _ in found] == ["skew_p"] and found[0][1] == pytest.approx(0.04, abs=0.006)
 
 
+def _pair(tmp_path, aircraft: str, h_ft: float, V_fps: float, seed: int, hz: float, kind: str, **kwargs):
+    """An identification recording and its validation doublets (seed + 50000), at the same
+    condition, rate and conventions: the script's ``id.csv`` and ``val.csv``."""
+    rec = fly(tmp_path / "id.csv", aircraft, h_ft, V_fps, seed, hz, kind, **kwargs)
+    val = fly(tmp_path / "val.csv", aircraft, h_ft, V_fps, seed + 50000, hz, "dbl3", **kwargs)
+    return rec, val
+
+
 def _package_xml(model: str) -> str:
     """The package aircraft ``model``'s XML path, its surfaces registered with the script (the
     elevator, left aileron and rudder positions, as the package's aircraft name them)."""
@@ -444,8 +452,7 @@ def test_a_sideslip_vane_bias_is_not_read_as_light_turbulence(tmp_path, monkeypa
     named at its size."""
     model = _package_xml("A4")
     _with_multisteps(monkeypatch)
-    rec = fly(tmp_path / "id.csv", "A4", 10790.0, 538.7, 42, 50.0, "3211_3", units="deg", amplitude_deg=3.17)
-    val = fly(tmp_path / "val.csv", "A4", 10790.0, 538.7, 50042, 50.0, "dbl3", units="deg", amplitude_deg=3.17)
+    rec, val = _pair(tmp_path, "A4", 10790.0, 538.7, 42, 50.0, "3211_3", units="deg", amplitude_deg=3.17)
     for path in (rec, val):
         _sensor_error(path, "beta_deg", lambda t, x: x + 1.0)
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
@@ -485,10 +492,8 @@ def test_an_accelerometer_ahead_of_the_cg_is_named_once(tmp_path, monkeypatch):
     position. It is named once (sensor_rules.name_accelerometer_once), at the larger t."""
     model = _package_xml("J3Cub")
     _with_multisteps(monkeypatch)
-    rec = fly(tmp_path / "id.csv", "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
-              amplitude_deg=2.94)
-    val = fly(tmp_path / "val.csv", "J3Cub", 1734.0, 117.9, 50158, 50.0, "dbl3", units="deg", noise=2.0,
-              amplitude_deg=2.94)
+    rec, val = _pair(tmp_path, "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
+                     amplitude_deg=2.94)
     for path in (rec, val):
         _accelerometer_ahead(path, 4.0)
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
@@ -517,8 +522,7 @@ def test_a_term_resting_on_an_uncertain_alpha_correction_is_not_named(tmp_path):
     within three of its standard errors, takes half of is withheld
     (term_rules.withhold_resting_on_an_uncertain_correction)."""
     model = _package_xml("c182")
-    rec = fly(tmp_path / "id.csv", "c182", 5080.0, 168.2, 174, 25.0, "dbl3", noise=0.5, amplitude_deg=3.43)
-    val = fly(tmp_path / "val.csv", "c182", 5080.0, 168.2, 50174, 25.0, "dbl3", noise=0.5, amplitude_deg=3.43)
+    rec, val = _pair(tmp_path, "c182", 5080.0, 168.2, 174, 25.0, "dbl3", noise=0.5, amplitude_deg=3.43)
     for path in (rec, val):
         _sensor_error(path, "p_rps", lambda t, x: np.interp(t - 0.04, t, x))
         _without_column(path, "h_ft")
@@ -537,8 +541,7 @@ def test_a_suspicion_lifted_leaves_a_term_another_rival_imitates_withheld(tmp_pa
     imitates is not lifted (replication.lift_unreplicated_suspicions)."""
     model = _package_xml("t6texan2")
     _with_multisteps(monkeypatch)
-    rec = fly(tmp_path / "id.csv", "t6texan2", 11639.0, 408.2, 2, 50.0, "3211_3", units="deg", amplitude_deg=3.23)
-    val = fly(tmp_path / "val.csv", "t6texan2", 11639.0, 408.2, 50002, 50.0, "dbl3", units="deg", amplitude_deg=3.23)
+    rec, val = _pair(tmp_path, "t6texan2", 11639.0, 408.2, 2, 50.0, "3211_3", units="deg", amplitude_deg=3.23)
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
     assert _found(result) == []
     term = next(c for c in result["candidates"] if c["parameter"] == "Cm_qhat")
@@ -612,10 +615,8 @@ def test_a_force_term_the_accelerometer_position_leaves_is_not_named(tmp_path, m
     model = _package_xml("c172x")
     _in_a_turn(monkeypatch, -22.0)
     _with_sweeps(monkeypatch)
-    rec = fly(tmp_path / "id.csv", "c172x", 4560.0, 186.5, 158, 25.0, "sweep_pitch", units="deg", noise=0.5,
-              amplitude_deg=5.15)
-    val = fly(tmp_path / "val.csv", "c172x", 4560.0, 186.5, 50158, 25.0, "dbl3", units="deg", noise=0.5,
-              amplitude_deg=5.15)
+    rec, val = _pair(tmp_path, "c172x", 4560.0, 186.5, 158, 25.0, "sweep_pitch", units="deg", noise=0.5,
+                     amplitude_deg=5.15)
     for path in (rec, val):
         _accelerometer_ahead(path, 4.0)
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
@@ -649,10 +650,7 @@ def test_an_alpha_bias_without_the_flight_path_needs_the_kinematic_entry_t(tmp_p
     it takes the kinematic entry t of 6 (sensor_rules.forced_entry_t); nothing is named."""
     model = _package_xml("c172p")
     _with_multisteps(monkeypatch)
-    rec = fly(tmp_path / "id.csv", "c172p", 3968.0, 183.9, 240, 25.0, "3211_3", units="deg", noise=0.5,
-              amplitude_deg=2.43)
-    val = fly(tmp_path / "val.csv", "c172p", 3968.0, 183.9, 50240, 25.0, "dbl3", units="deg", noise=0.5,
-              amplitude_deg=2.43)
+    rec, val = _pair(tmp_path, "c172p", 3968.0, 183.9, 240, 25.0, "3211_3", units="deg", noise=0.5, amplitude_deg=2.43)
     for path in (rec, val):
         _sensor_error(path, "q_dps", lambda t, x: np.interp(t - 0.04, t, x))
         _without_column(path, "h_ft")
@@ -671,10 +669,8 @@ def test_a_rate_derivative_an_airspeed_bias_would_imitate_is_not_named(tmp_path,
     nothing is named."""
     model = _package_xml("pa28")
     _with_sweeps(monkeypatch)
-    rec = fly(tmp_path / "id.csv", "pa28", 2928.0, 153.7, 299, 50.0, "sweep_lat", units="deg", noise=0.5,
-              amplitude_deg=3.45)
-    val = fly(tmp_path / "val.csv", "pa28", 2928.0, 153.7, 50299, 50.0, "dbl3", units="deg", noise=0.5,
-              amplitude_deg=3.45)
+    rec, val = _pair(tmp_path, "pa28", 2928.0, 153.7, 299, 50.0, "sweep_lat", units="deg", noise=0.5,
+                     amplitude_deg=3.45)
     for path in (rec, val):
         _sensor_error(path, "V_fps", lambda t, x: x + 10.0)
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
