@@ -1,19 +1,34 @@
 """The airspeed the rate terms are normalised by: a rate derivative or α̇ term is named only
-when an airspeed error the kinematics allow would not imitate it."""
+when it stands beside what an airspeed error the kinematics allow would put in the mismatch."""
 from __future__ import annotations
 
+import numpy as np
+
+from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
+from harness.diagnosis import candidates as cand
+from harness.diagnosis.along import corrected_recording, interior, model_along
 from harness.diagnosis.evidence import Candidate
-from harness.diagnosis.kinematics import KinematicResult
-from harness.diagnosis.term_rules import IMITATION_SHARE, IMITATION_Z, term_change
+from harness.diagnosis.kinematics import PLAUSIBLE, KinematicResult
+from harness.diagnosis.prepare import Prepared
+from harness.diagnosis.sensor_rules import kinematic_estimate, kinematic_std_error
+from harness.diagnosis.stepwise_axes import StepwiseFits
+from harness.diagnosis.term_rules import IMITATION_Z
+from models.aircraft import Aircraft
+from models.replay import InitialCondition
 
-__all__ = ["AIRSPEED_ERRORS", "normalised_by_airspeed", "withhold_on_the_airspeed"]
+__all__ = ["AIRSPEED_BIAS", "airspeed_signature", "normalised_by_airspeed", "withhold_on_the_airspeed"]
 
 
-# The airspeed errors the kinematic check sizes (effects.md's sensor_bias and sensor_scale of V).
-AIRSPEED_ERRORS = ("bias_V", "scale_V")
+# The kinematic check's airspeed error (effects.md's sensor_bias of V): over a maneuver that
+# hardly moves V a scale factor is the same error, k·V.
+AIRSPEED_BIAS = "bias_V"
 
 # The regressors normalised by the airspeed: p̂ = p b/2V, q̂ = q c̄/2V, r̂ = r b/2V, α̇ c̄/2V.
 NORMALISED = ("phat", "qhat", "rhat")
+
+# The airspeed error probed for the signature, as a share of the airspeed (it is linear there).
+SIGNATURE_SHARE = 0.01
 
 
 def normalised_by_airspeed(c: Candidate) -> bool:
@@ -23,31 +38,63 @@ def normalised_by_airspeed(c: Candidate) -> bool:
                                                and c.parameter.split("_", 1)[-1] in NORMALISED)
 
 
-def withhold_on_the_airspeed(cands: list[Candidate], kin: KinematicResult, imitated) -> None:
-    """Deselect a rate term (:func:`normalised_by_airspeed`) that an airspeed error would
-    imitate: the V bias or scale anywhere within :data:`term_rules.IMITATION_Z` standard
-    errors of its kinematic estimate, whatever its t (``imitated``,
-    :func:`term_rules.imitation`: the channels corrected, the model evaluated again), takes at
-    least :data:`term_rules.IMITATION_SHARE` of the term's change. The model evaluated along
-    an airspeed k·V too high normalises every rate by it, and the mismatch then holds a
-    change of −k/(1+k) of each rate derivative, in its own shape; a maneuver that hardly moves
-    V cannot size the error (an independent script's pa28, 154 ft/s, lateral sweep at 50 Hz,
-    with V 10 ft/s high had a C_l,p̂ change of −0.026 on −0.47 named, t −17; the kinematics put
-    the bias at −3.2 ± 4.8 ft/s)."""
-    if imitated is None:
+def airspeed_signature(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
+                       mismatch: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], float]:
+    """What an airspeed bias puts in each coefficient's mismatch, per ft/s: the channels
+    corrected by a bias of :data:`SIGNATURE_SHARE` of the airspeed, the model evaluated again
+    (the rates normalised by the other V, the kinematic α̇, q̄ where it is built from V), the
+    difference divided by it. Returns the columns and the airspeed (ft/s)."""
+    V0 = float(np.mean(p.smooth["V"]))
+    dv = SIGNATURE_SHARE * V0
+    changed = model_along(corrected_recording(p, kin, {AIRSPEED_BIAS: dv}), aircraft, ic, inertial_from=p).mismatch()
+    return {c: (changed[c] - mismatch[c]) / dv for c in mismatch}, V0
+
+
+def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: KinematicResult, aircraft: Aircraft,
+                             ic: InitialCondition, mismatch: dict[str, np.ndarray], step: StepwiseFits) -> None:
+    """Deselect a rate term (:func:`normalised_by_airspeed`) that does not stand beside an
+    airspeed error the kinematics allow. The model evaluated along an airspeed k·V too high
+    normalises every rate by it, and the mismatch then holds −k/(1+k) of each rate term, in
+    its shape. The axis's mismatch is fitted on the error's signature
+    (:func:`airspeed_signature`) in the term's place (with the axis's other selected terms and
+    its nuisance columns); when the airspeed error so sized is one an instrument could make
+    (within :data:`kinematics.PLAUSIBLE`'s 10 % of V for an airspeed scale, which over a
+    maneuver that hardly moves V is the same error) and lies within
+    :data:`term_rules.IMITATION_Z` standard errors of the kinematics' bias estimate, and the
+    term fitted beside the signature falls below the entry t (:data:`candidates.T_IN`), it is
+    withheld. An independent script's pa28 (154 ft/s, lateral sweep at 50 Hz) with V 10 ft/s
+    high had a C_l,p̂ change of −0.026 on −0.47 named (t −17); the kinematics put the bias at
+    −3.2 ± 4.8 ft/s."""
+    terms = [c for c in cands if c.selected and c.test.startswith("stepwise") and normalised_by_airspeed(c)]
+    found = kinematic_estimate(kin, AIRSPEED_BIAS)
+    if not terms or found is None:
         return
-    for c in cands:
-        if not (c.selected and c.test.startswith("stepwise") and normalised_by_airspeed(c)):
+    v, se = found[0], kinematic_std_error(kin, AIRSPEED_BIAS)
+    signature, V0 = airspeed_signature(p, kin, aircraft, ic, mismatch)
+    inner = interior(p)
+    for c in terms:
+        sel, by_key = step.selections.get(c.channel, (None, {}))
+        key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
+        if sel is None or key is None:
             continue
-        change = abs(term_change(c))
-        for name in AIRSPEED_ERRORS:
-            size = imitated(c, name) if name in kin.parameters else None
-            if size is None or size < IMITATION_SHARE * change:
-                continue
-            c.selected = False
-            c.details["sensor_rival"] = name
-            c.details["airspeed_rival"] = {"parameter": name, "imitates_at_most": size, "change": change}
-            c.reason = (f"entered, but not named: the airspeed its rate is normalised by is not known well "
-                        f"enough; an airspeed {name.split('_')[0]} within {IMITATION_Z:g} standard errors of the "
-                        f"kinematics' estimate would imitate {size:.2g} of this change of {change:.3g}")
-            break
+        sig = signature[c.channel][inner]
+        others = [by_key[k].column[inner] for k in sel.names if k != key and k in by_key]
+        others += [x[inner] for x in step.nuisances.get(c.channel, {}).values() if np.ptp(x[inner]) > 0]
+        z = mismatch[c.channel][inner]
+        try:
+            alone, _, _ = colored_fit(z, [sig] + others, ["airspeed"] + [f"o{i}" for i in range(len(others))])
+            both, se_both, _ = colored_fit(z, [by_key[key].column[inner], sig] + others,
+                                           ["term", "airspeed"] + [f"o{i}" for i in range(len(others))])
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            continue
+        u, t_term = float(alone[0]), float(both[0] / se_both[0]) if se_both[0] > 0 else 0.0
+        plausible = abs(u) <= PLAUSIBLE["scale"]["V"] * V0
+        allowed = np.isfinite(se) and abs(u - v) <= IMITATION_Z * se
+        c.details["beside_the_airspeed"] = {"bias_fps": u, "t": t_term}
+        if not (plausible and allowed and abs(t_term) < cand.T_IN):
+            continue
+        c.selected = False
+        c.details["sensor_rival"] = AIRSPEED_BIAS
+        c.reason = (f"entered, but not named: an airspeed error of {u:+.3g} ft/s ({100 * u / V0:+.1f} % of V; the "
+                    f"kinematics allow {v:.3g} ± {IMITATION_Z:g}·{se:.2g}), normalising the rates, fits the "
+                    f"mismatch in its place, and beside it this term stands at t = {t_term:.1f}")

@@ -141,7 +141,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
     withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin), contested)
     withhold_resting_on_an_uncertain_correction(cands, kin, sensor_values, imitated)
-    withhold_on_the_airspeed(cands, kin, imitated)
+    withhold_on_the_airspeed(cands, p, kin, aircraft, ic, mismatch, step)
     if turbulent:
         withhold_in_turbulence(cands)
     else:
