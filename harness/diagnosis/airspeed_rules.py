@@ -82,7 +82,8 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
         others += [x[inner] for x in step.nuisances.get(c.channel, {}).values() if np.ptp(x[inner]) > 0]
         z = mismatch[c.channel][inner]
         try:
-            alone, _, _ = colored_fit(z, [sig] + others, ["airspeed"] + [f"o{i}" for i in range(len(others))])
+            # the error's size in the term's place (its standard error is not needed)
+            alone = np.linalg.lstsq(np.column_stack([sig] + others + [np.ones(z.size)]), z, rcond=None)[0]
             both, se_both, _ = colored_fit(z, [by_key[key].column[inner], sig] + others,
                                            ["term", "airspeed"] + [f"o{i}" for i in range(len(others))])
         except (SingularRegressorsError, np.linalg.LinAlgError):

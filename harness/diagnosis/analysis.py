@@ -57,9 +57,9 @@ def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str,
 
 
 def _along_corrected(recorded: Prepared, kin: KinematicResult, values: dict[str, float], aircraft: Aircraft,
-                     ic: InitialCondition) -> tuple[Prepared, ModelAlong, dict[str, dict]]:
-    """The recording corrected for the sensor ``values``, the model along it, and the
-    accelerometer position components the force mismatch there refutes
+                     ic: InitialCondition) -> tuple[Prepared, ModelAlong, dict[str, np.ndarray], dict[str, dict]]:
+    """The recording corrected for the sensor ``values``, the model along it, its mismatch,
+    and the accelerometer position components the force mismatch there refutes
     (:func:`accelerometer_rules.refuted_positions`): those are taken out of ``values`` (in
     place) and the correction and the model made again without them."""
     p = corrected_recording(recorded, kin, values)
@@ -71,7 +71,8 @@ def _along_corrected(recorded: Prepared, kin: KinematicResult, values: dict[str,
             values.pop(name)
         p = corrected_recording(recorded, kin, values)
         along = model_along(p, aircraft, ic)
-    return p, along, refuted
+        mismatch = along.mismatch()
+    return p, along, mismatch, refuted
 
 
 def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
@@ -93,9 +94,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
                      if n not in contested and steady_vane(n, p) is None}
     # 2. the model along the measured states
-    recorded, (p, along, refuted) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
+    recorded, (p, along, mismatch, refuted) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along[:5]
-    mismatch = along.mismatch()
     slope_of = slope_function(aircraft, ic, states, surfaces, alphadot, aero)
     # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)
     near = near if not sensor_values else ""  # a corrected recording is not asked again
