@@ -249,6 +249,35 @@ def test_axes_their_own_terms_imitate_are_no_second_test():
     assert imitated_by_own_terms((ax("Cl", 1.0, 0.2, 1.0, 0.09), ax("Cn", 1.0, 0.2, 1.0, 0.01))) == ""
 
 
+def test_a_practical_share_on_imitated_axes_needs_the_kinematics_own_suspicion():
+    """corroborate.imitated_by_own_terms: every showing axis a change of its own term, one of
+    them of practical size, tells the sensor only where the kinematics stand at
+    ONE_AXIS_KINEMATIC_T: the Global 5000 whose C_m,q̂ change of −4 named an α vane 18 ft ahead
+    (kinematic 11 ± 4.4 ft, C_m 2.0 ± 0.2 times as C_m,q̂, r 0.999, share 0.040; C_X 1.25 ±
+    0.53 as C_X,q̂, r 0.97) is refuted; the a_z skew's C_Z (share 0.097) at kinematic t 3.6
+    is not."""
+    from harness.diagnosis.corroborate import ONE_AXIS_KINEMATIC_T, imitated_by_own_terms
+
+    def ax(name, ratio, se, r, share):
+        return AxisRatio(name, ratio, se, imitator="term", imitator_r=r, share=share)
+    axes = {"CX": ax("CX", 1.253, 0.53, 0.97, 0.036), "CZ": ax("CZ", 0.588, 0.523, 1.0, 0.017),
+            "Cm": ax("Cm", 2.012, 0.197, 0.999, 0.0401)}
+    why = imitated_by_own_terms(tuple(axes.values()), 11.05 / 4.40)
+    assert "kinematics only at t = 2.5" in why and "a change of the term itself" in why
+    v = corroborate("vane_alpha_x", 11.05, 4.40, axes, t_aero=5.0)
+    assert not v.named and "kinematics only at t = 2.5" in v.reason
+    assert imitated_by_own_terms(tuple(axes.values()), ONE_AXIS_KINEMATIC_T) == ""
+    assert imitated_by_own_terms((ax("CZ", 1.24, 0.17, 0.974, 0.097),), 3.6) == ""
+
+
+def test_a_share_under_the_practical_limit_never_prints_as_the_limit():
+    """candidates.share_below_practical: 3.96 % reads "3.96 %", not "4.0 % (under 4 %)"."""
+    from harness.diagnosis.candidates import share_below_practical
+    assert share_below_practical(0.0396) == "3.96 % of the coefficient's excursion (under 4 %)"
+    assert share_below_practical(0.032).startswith("3.2 % ")
+    assert share_below_practical(0.03999).startswith("3.999 % ")
+
+
 def test_one_axis_needs_the_kinematics_at_three_standard_errors():
     """corroborate.one_axis_and_a_weak_suspicion: a c182 in a banked turn whose C_m carried an
     α² change had a q scale named from C_m alone (0.90 ± 0.15) and the kinematics at t 2.5; at

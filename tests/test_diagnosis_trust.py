@@ -1626,10 +1626,12 @@ def _jet_drift_case(estimate: float, raw: dict | None = None):
 
 def test_the_thrust_moment_bound_is_lapse_times_thrust_times_its_offset_over_qbar_s_cbar():
     """|ΔC_m| per unit ΔV/V ≤ THRUST_LAPSE_MAX · T · |z_T| / (q̄ S c̄), with the larger of the
-    model's and the metadata's thrust-line offsets."""
-    from harness.diagnosis.stepwise_axes import THRUST_LAPSE_MAX, thrust_moment_bound
+    model's and the metadata's thrust-line offsets; without the metadata's offset Eq. 4 leaves
+    the whole moment in the measured C_m, and q̄ ∝ V² adds QBAR_PER_DV to the lapse."""
+    from harness.diagnosis.stepwise_axes import QBAR_PER_DV, THRUST_LAPSE_MAX, thrust_moment_bound
     p, trim, _ = _jet_drift_case(0.0)
-    assert thrust_moment_bound(p, trim) == pytest.approx(THRUST_LAPSE_MAX * 2000.0 * 0.3 / (160.0 * 300.0 * 11.32))
+    moment = 2000.0 * 0.3 / (160.0 * 300.0 * 11.32)
+    assert thrust_moment_bound(p, trim) == pytest.approx((THRUST_LAPSE_MAX + QBAR_PER_DV) * moment)
     p.meta["thrust_offset_ft"] = 0.5
     assert thrust_moment_bound(p, trim) == pytest.approx(THRUST_LAPSE_MAX * 2000.0 * 0.5 / (160.0 * 300.0 * 11.32))
 
@@ -1637,14 +1639,14 @@ def test_the_thrust_moment_bound_is_lapse_times_thrust_times_its_offset_over_qba
 @pytest.mark.parametrize("estimate, named", [(0.003, False), (-0.003, False), (0.02, True)])
 def test_a_jet_pitch_drift_without_thrust_is_named_only_beyond_what_the_thrust_could_imitate(estimate, named):
     """Without a thrust channel a jet's C_m ΔV/V term is offered (its thrust moment is small),
-    and named only two standard errors beyond the bound (0.0022 here); with thrust recorded
+    and named only two standard errors beyond the bound (0.0044 here); with thrust recorded
     the rule stays out of the way."""
     from harness.diagnosis.stepwise_axes import withhold_thrust_drift
     p, trim, c = _jet_drift_case(estimate)
     withhold_thrust_drift([c], p, trim)
     assert c.selected is named
-    assert c.details["thrust_bound"] == pytest.approx(0.0022, abs=1e-4)
-    assert "could imitate a C_m drift of up to 0.0022" in c.reason
+    assert c.details["thrust_bound"] == pytest.approx(0.0044, abs=1e-4)
+    assert "could imitate a C_m drift of up to 0.0044" in c.reason
     assert c.reason.startswith("not named") != named
     p, trim, c = _jet_drift_case(estimate, raw={"thrust": np.zeros(3)})
     withhold_thrust_drift([c], p, trim)

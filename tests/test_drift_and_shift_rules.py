@@ -5,6 +5,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from harness.diagnosis.candidates import Term
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
@@ -59,13 +60,21 @@ def test_a_mistrim_the_thrust_line_can_make_names_no_moment_reference_shift():
     of thrust at q̄ 265 psf (S 260 ft², c̄ 10.8 ft) mistrims C_m by 0.0025 when thrust is not
     recorded, so the 0.114 ft shift its C_m constant says (−0.0024 ± 0.0002 at a mean C_Z of
     −0.2) is not named; a shift mistrimming C_m five times that is; with thrust and its line
-    recorded, the bound is zero."""
-    from harness.diagnosis.stepwise_axes import CgMeanTest, pinned_shift, thrust_mistrim_bound
+    recorded, the bound is zero. Where the airspeed falls the bound is the moment's mean
+    coefficient along the recorded q̄, the thrust raised by the lapse: (V₀/V)^lapse."""
+    from harness.diagnosis.stepwise_axes import THRUST_LAPSE_MAX, CgMeanTest, pinned_shift, thrust_mistrim_bound
+    steady = {"qbar": np.full(N, 265.0), "V": np.full(N, 550.0)}
     p = SimpleNamespace(n=N, dt=DT, raw={}, meta={"geometry": {"S_ft2": 260.0, "b_ft": 27.5, "cbar_ft": 10.8}},
-                        measured={"CZ": np.full(N, -0.2)})
+                        measured={"CZ": np.full(N, -0.2)}, smooth=steady, start={"V": 550.0})
     trim = SimpleNamespace(thrust_lbf=1817.0, thrust_offset_ft=-1.04, qbar_psf=265.0)
     bound = thrust_mistrim_bound(p, trim)
-    assert bound == np.float64(1817.0 * 1.04 / (265.0 * 260.0 * 10.8))
+    assert bound == pytest.approx(1817.0 * 1.04 / (265.0 * 260.0 * 10.8), rel=1e-12)
+    ratio = np.linspace(1.0, 0.9, N)  # slowing by 10 %
+    slowing = SimpleNamespace(**{**vars(p), "smooth": {"qbar": 265.0 * ratio ** 2, "V": 550.0 * ratio}})
+    from harness.diagnosis.prepare import interior_slice
+    inner = interior_slice(N, DT)
+    expected = bound * np.mean(ratio[inner] ** -(2.0 + THRUST_LAPSE_MAX))
+    assert thrust_mistrim_bound(slowing, trim) == pytest.approx(expected, rel=1e-9)
     test = CgMeanTest(True, "", 0.114, 0.011, True, 0.12, 0.4)
     c = pinned_shift(test, p, trim)
     assert not c.selected and "thrust" in c.reason and c.details["thrust_mistrim_bound"] == bound

@@ -677,3 +677,28 @@ def test_a_rate_derivative_an_airspeed_bias_would_imitate_is_not_named(tmp_path,
     assert {p for p, _ in _found(result)} <= {"bias_V"}
     term = next(c for c in result["candidates"] if c["parameter"] == "Cl_phat")
     assert not term["selected"] and "airspeed" in term["reason"], term["reason"]
+
+
+def test_a_rate_term_the_euler_lag_leaves_impractical_is_not_named(tmp_path):
+    """Noise-free c172x three-axis doublets at 100 Hz (4,700 ft / 196 ft/s, 5.5°): C_m,α̇ came
+    out +1.63 over the model's (t 24, 5.5 % of C_m's excursion) and was named; the gyros read
+    5.0 ms ahead (t 266), and the rates' derivatives advanced by that lag imitate just under
+    half of it, leaving a change under the practical share (term_rules.left_impractical)."""
+    rec = fly(tmp_path / "dbl3.csv", "c172x", 4713.0, 196.3, 141, 100.0, "dbl3", noise=0.0, amplitude_deg=5.51)
+    result = diagnose("c172x", rec, tmp_path / "out", calibrate=False)
+    assert _found(result) == []
+    alphadot = next(c for c in result["candidates"] if c["parameter"] == "Cm_alphadot")
+    assert "rectangular Euler" in alphadot["reason"] and alphadot["estimate"] > -5.2 + 1.0
+
+
+def test_what_the_euler_lag_leaves_must_itself_be_practical():
+    """term_rules.left_impractical: a C_m,α̇ change of 1.51 explaining 5.5 % of C_m's
+    excursion, 0.75 of it imitated, leaves 2.7 %: withheld; imitated 0.2 it leaves 4.8 %: kept;
+    an imitation of the other sign never withholds."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.term_rules import left_impractical
+    c = Candidate("unsteady_alphadot", "pitch", "Cm", "Cm_alphadot", 1.51, 0.05, 30.0, 0.1, "per rad",
+                  "stepwise on the Cm mismatch", True, "entered", {"excursion_share": 0.055})
+    assert left_impractical(c, 0.75, 1.51)
+    assert not left_impractical(c, 0.2, 1.51)
+    assert not left_impractical(c, -0.75, 1.51)

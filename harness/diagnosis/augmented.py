@@ -379,8 +379,7 @@ def _too_small_calibrated(f: Candidate, size: float, ee: float) -> str:
     ratio = abs(size / ee) if ee else 1.0
     share = f.details.get("excursion_share")
     if share is not None and share * ratio < cand.PRACTICAL_SHARE:
-        return (f"so small that it explains {100 * share * ratio:.1f} % of the coefficient's excursion (under "
-                f"{100 * cand.PRACTICAL_SHARE:.0f} %)")
+        return f"so small that it explains {cand.share_below_practical(share * ratio)}"
     if f.std_error > 0 and abs(ee - size) > CALIBRATED_MIN_Z * f.std_error and abs(size) < cand.T_IN * f.std_error:
         return (f"so far under the equation error's size ({abs(ee - size) / f.std_error:.1f} of its standard errors) "
                 f"that it would not have entered (t = {size / f.std_error:.1f} at the equation error's standard "

@@ -244,6 +244,15 @@ def contribution_share(column: np.ndarray, coefficient: float, measured: np.ndar
 PRACTICAL_SHARE = 0.04
 
 
+def share_below_practical(share: float) -> str:
+    """"x % of the coefficient's excursion (under 4 %)" for a share under
+    :data:`PRACTICAL_SHARE`, with as many decimals as it takes not to print the limit itself
+    (3.96 % read "4.0 % (under 4 %)")."""
+    limit = 100 * PRACTICAL_SHARE
+    digits = next((d for d in (1, 2, 3) if round(100 * share, d) < limit), 4)
+    return f"{100 * share:.{digits}f} % of the coefficient's excursion (under {limit:.0f} %)"
+
+
 @dataclass(frozen=True)
 class DelayScan:
     surface: str

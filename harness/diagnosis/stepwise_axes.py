@@ -323,27 +323,47 @@ def thrust_line_offset(p: Prepared, trim: TrimPoint) -> float:
 
 
 def thrust_mistrim_bound(p: Prepared, trim: TrimPoint) -> float:
-    """The C_m mistrim the thrust's own moment can make when thrust is not recorded:
-    ``T · |z_T| / (q̄ S c̄)``, T and q̄ at the model's trim, z_T from
-    :func:`thrust_line_offset` (zero with a thrust channel and the metadata's
-    ``thrust_offset_ft``: Eqs. 1 and 4 then take the moment out). An independent script's A-4
-    (thrust line 1.04 ft above its c.g.) in a 20° banked turn at 550 ft/s had a C_m constant
-    of −0.0027 on its null, −0.0026 with C_m,α −0.25, where the stepwise entered a shift for
-    the C_m,α change and the shift the mistrim says, 0.114 ft aft, was named."""
+    """The C_m mistrim the thrust's own moment can make when thrust is not recorded: the mean
+    over the maneuver's interior of ``T · |z_T| / (q̄ S c̄)``, T the model's trim thrust raised
+    as far as the lapse :data:`THRUST_LAPSE_MAX` allows where the airspeed fell below its start,
+    ``(V_0/V)^lapse``, q̄ the recorded dynamic pressure, z_T from :func:`thrust_line_offset`
+    (zero with a thrust channel and the metadata's ``thrust_offset_ft``: Eqs. 1 and 4 then take
+    the moment out). An independent script's A-4 (thrust line 1.04 ft above its c.g.) in a
+    20° banked turn at 550 ft/s had a C_m constant of −0.0027 on its null, −0.0026 with C_m,α
+    −0.25, where the stepwise entered a shift for the C_m,α change and the shift the mistrim
+    says, 0.114 ft aft, was named. At the trim's q̄ alone the bound missed the slowing: an
+    OV-10 (thrust line 0.94 ft from its c.g.) in a 33° banked turn at 348 ft/s, slowing to
+    319 ft/s over a three-axis 3-2-1-1, with C_m,α −0.15, had a constant of 0.0072 ± 0.0004
+    noise-free against a trim bound of 0.0073, and with twice the noise the 0.105 ft shift it
+    says was named."""
     if "thrust" in p.raw and "thrust_offset_ft" in p.meta:
         return 0.0
     geo = p.meta["geometry"]
-    return abs(trim.thrust_lbf) * thrust_line_offset(p, trim) / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"])
+    inner = interior(p)
+    qbar, V = p.smooth["qbar"][inner], p.smooth["V"][inner]
+    lapse = np.maximum(1.0, (p.start["V"] / V) ** THRUST_LAPSE_MAX)
+    return (abs(trim.thrust_lbf) * thrust_line_offset(p, trim) / (geo["S_ft2"] * geo["cbar_ft"])
+            * float(np.mean(lapse / qbar)))
 
 
 def thrust_moment_bound(p: Prepared, trim: TrimPoint) -> float:
-    """The largest C_m change per unit ΔV/V that the thrust's own change with airspeed can
-    put into the mismatch when thrust is not recorded (held at trim):
-    ``THRUST_LAPSE_MAX · T · |z_T| / (q̄ S c̄)``, with T and q̄ at the model's trim and z_T
-    from :func:`thrust_line_offset`."""
+    """The largest C_m change per unit ΔV/V that the thrust's moment can put into the
+    mismatch when thrust is not recorded (held at trim): ``k · T · |z_T| / (q̄ S c̄)``, with T
+    and q̄ at the model's trim and z_T from :func:`thrust_line_offset`.
+
+    Seed Eq. 4 takes ``T · z_T`` out of the measured C_m with the metadata's
+    ``thrust_offset_ft``; the model's C_m holds no thrust-line moment. With the offset given,
+    the mismatch keeps the thrust's change, ``ΔT · z_T / (q̄ S c̄)``: k is the lapse
+    :data:`THRUST_LAPSE_MAX`. Without it the whole moment stays, and its coefficient moves with
+    the dynamic pressure that divides it as well, −2 per unit ΔV/V: k is
+    ``THRUST_LAPSE_MAX`` + :data:`QBAR_PER_DV`. A noise-free F-15 flight of the model itself
+    (13,400 ft / 742 ft/s, three-axis 3-2-1-1, slowing 17 %) drew C_m,ΔV −0.0026 (t −9),
+    which its propulsive moment coefficient along the flight shows, −0.0025 (C_m,T 0.0009,
+    thrust lapse −0.65); a C_l,δa change there named a C_m,ΔV −0.0036 ± 0.0007 beside it,
+    past the lapse-only bound of 0.0015."""
     geo = p.meta["geometry"]
-    return (THRUST_LAPSE_MAX * abs(trim.thrust_lbf) * thrust_line_offset(p, trim)
-            / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"]))
+    k = THRUST_LAPSE_MAX + (0.0 if "thrust_offset_ft" in p.meta else QBAR_PER_DV)
+    return k * abs(trim.thrust_lbf) * thrust_line_offset(p, trim) / (trim.qbar_psf * geo["S_ft2"] * geo["cbar_ft"])
 
 
 def withhold_thrust_drift(cands: list[Candidate], p: Prepared, trim: TrimPoint) -> None:
@@ -354,7 +374,8 @@ def withhold_thrust_drift(cands: list[Candidate], p: Prepared, trim: TrimPoint) 
     if "thrust" in p.raw:
         return
     bound = thrust_moment_bound(p, trim)
-    why = (f"thrust was not recorded, and its change with airspeed, through a thrust line "
+    left = "" if "thrust_offset_ft" in p.meta else " and the dynamic pressure dividing its moment"
+    why = (f"thrust was not recorded, and its change with airspeed{left}, through a thrust line "
            f"{thrust_line_offset(p, trim):.2f} ft from the c.g., could imitate a C_m drift of up to {bound:.2g} "
            "per unit ΔV/V")
     for c in cands:
@@ -394,6 +415,9 @@ NOT_WITH_THROTTLE = ("not named: the throttle moved and thrust was not recorded;
 # fastest a propeller's falls); a jet's net thrust, m_dot (V_jet - V) with m_dot rising with
 # the ram pressure, falls more slowly than that.
 THRUST_LAPSE_MAX = 2.0
+# d ln q̄ / d ln V at a steady altitude: a thrust moment left in the measured C_m
+# (no thrust_offset_ft) changes its coefficient by this much per unit ΔV/V (thrust_moment_bound).
+QBAR_PER_DV = 2.0
 
 
 PROPELLER_DRIFT = ("the propeller's torque, P-factor and slipstream change with airspeed at a fixed throttle, "
@@ -437,8 +461,7 @@ def _practical(share: float) -> bool:
 
 
 def _impractical_reason(share: float) -> str:
-    return (f"entered, but too small to matter: it explains {100 * share:.1f} % of the coefficient's excursion "
-            f"(under {100 * cand.PRACTICAL_SHARE:.0f} %)")
+    return f"entered, but too small to matter: it explains {cand.share_below_practical(share)}"
 
 
 def aero_candidates(selections: dict, delays: dict, dt: float,
