@@ -702,3 +702,85 @@ def test_what_the_euler_lag_leaves_must_itself_be_practical():
     assert left_impractical(c, 0.75, 1.51)
     assert not left_impractical(c, 0.2, 1.51)
     assert not left_impractical(c, -0.75, 1.51)
+
+
+def test_after_a_gyro_skew_is_applied_the_euler_lag_reaches_every_term_of_its_axis(tmp_path, monkeypatch):
+    """The package's A-4 (9,110 ft / 529 ft/s, a pitch 3-2-1-1 in a 32.5° turn at 100 Hz, half
+    the noise) with q 40 ms late: the kinematics name the skew at 35 ms (the sensor's 40 less
+    the 5 ms lead JSBSim's rectangular-Euler step gives the rates), and the correction leaves
+    q̇ lagging the moments by a whole step; a C_m,δe change of −0.021 (4.3 % of C_m's
+    excursion) was named beside the skew. The lag a correction leaves is asked of every C_m
+    term (term_rules.euler_lag_estimate, after_skew): the skew alone is named."""
+    model = _package_xml("A4")
+    _with_multisteps(monkeypatch)
+    _in_a_turn(monkeypatch, -32.5)
+    rec = fly(tmp_path / "id.csv", "A4", 9110.0, 529.2, 363, 100.0, "3211_pitch", noise=0.5, amplitude_deg=3.1)
+    _sensor_error(rec, "q_rps", lambda t, x: np.interp(t - 0.04, t, x))
+    result = diagnose(model, rec, tmp_path / "out", calibrate=False)
+    assert [p for p, _ in _found(result)] == ["skew_q"]
+    term = next(c for c in result["candidates"] if c["parameter"] == "Cm_de")
+    assert not term["selected"] and "took in the lead" in term["reason"], term["reason"]
+
+
+@pytest.mark.parametrize("late", ["resampled", 0.04])
+def test_the_air_share_is_read_along_the_vane_where_the_model_follows_the_inertial_alpha(tmp_path, monkeypatch,
+                                                                                          late):
+    """The package's 787-8 (27,500 ft / 791 ft/s, a stabilator sweep at 40 Hz, twice the noise,
+    no h channel): α moves under its vane's noise, so the model follows the inertial α. With q
+    resampled 40 ms late and back by linear interpolation (its noise colored, as aligning two
+    buses does) the gust estimate reached 4.8 ft/s, and the air-share test, reading the
+    vane's wander along the inertial α, called it air (share 1.01 ± 0.03): turbulence named
+    (gust_rules.air_share_test now evaluates along the vane: 0.25). With q 40 ms late the
+    inertial α carries −τ·q, read as a C_Z,q̂ change of −8.9 (t −7.5); the skews of the
+    channels that α is integrated from are asked of C_X, C_Z and C_m
+    (term_rules.inertial_alpha_sensors): nothing is named."""
+    model = _package_xml("787-8")
+    _with_sweeps(monkeypatch)
+    rec, val = _pair(tmp_path, "787-8", 27502.0, 791.5, 420, 40.0, "sweep_pitch", units="deg", noise=2.0,
+                     amplitude_deg=2.42)
+    for path in (rec, val):
+        _without_column(path, "h_ft")
+        if late == "resampled":
+            _sensor_error(path, "q_dps", lambda t, x: np.interp(t + 0.04, t, np.interp(t - 0.04, t, x)))
+        else:
+            _sensor_error(path, "q_dps", lambda t, x: np.interp(t - late, t, x))
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert _found(result) == []
+
+
+def test_a_shift_whose_mistrim_the_thrust_can_make_is_not_named_for_a_pitch_stiffness_change(tmp_path, monkeypatch):
+    """The package's T-37 (6,900 ft / 382 ft/s, a pitch 3-2-1-1 at 100 Hz, metric units) with
+    C_m,α 0.15 lower about its trim α: C_m's stepwise entered a moment-reference shift of
+    0.186 ft for it (its C_Z column follows α with less noise than the vane; C_m,α at t 2.9
+    beside it), and C_m's constant, −0.0042, did not refute it — the thrust's moment through
+    the model's thrust line, 0.73 ft from the c.g., makes up to 0.0045 when thrust is not
+    recorded (stepwise_axes.withhold_shift_within_thrust). No shift is named."""
+    from independent_script import trimmed
+    model = _package_xml("T37")
+    _with_multisteps(monkeypatch)
+    alpha0 = trimmed("T37", 6925.0, 382.3)["aero/alpha-rad"]
+    root = _f16_with_extra_term(tmp_path / "root", "PITCH", ("aero/qbar-psf", "metrics/Sw-sqft", "metrics/cbarw-ft"),
+                                -0.15, _from_trim(alpha0), model="T37")
+    rec, val = _pair(tmp_path, "T37", 6925.0, 382.3, 556, 100.0, "3211_pitch", units="metric", noise=1.0,
+                     amplitude_deg=3.12, root=root)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert "dx_moment_reference" not in [p for p, _ in _found(result)]
+    shift = next(c for c in result["candidates"] if c["parameter"] == "dx_moment_reference")
+    assert not shift["selected"] and "thrust" in shift["reason"], shift["reason"]
+
+
+def test_an_accelerometer_position_reaches_the_lateral_terms_through_the_inertial_sideslip(tmp_path, monkeypatch):
+    """The package's c172r (3,300 ft / 165 ft/s, doublets on each axis in a 28° turn at 40 Hz)
+    with its accelerometer 4 ft ahead of the c.g.: the position is named (3.6 ft), and a C_l,r̂
+    change of +0.022 (t 6.6) was named beside it — the inertial sideslip the model follows is
+    integrated from a_y, which carries ṙ·x, and C_l,β·x·r/V reads as C_l,r̂
+    (accelerometer_rules.withhold_through_the_inertial_angles). The position alone is named."""
+    model = _package_xml("c172r")
+    _in_a_turn(monkeypatch, -28.2)
+    rec, val = _pair(tmp_path, "c172r", 3315.0, 164.8, 546, 40.0, "dbl3", units="deg", noise=1.0, amplitude_deg=2.76)
+    for path in (rec, val):
+        _accelerometer_ahead(path, 4.0)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert [p for p, _ in _found(result)] in (["x_accelerometer"], ["offset_x"])
+    term = next(c for c in result["candidates"] if c["parameter"] == "Cl_rhat")
+    assert not term["selected"], term["reason"]

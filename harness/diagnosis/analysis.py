@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refuted_positions,
-                                                   withhold_beside_the_accelerometer)
+                                                   withhold_beside_the_accelerometer,
+                                                   withhold_through_the_inertial_angles)
 from harness.diagnosis.airspeed_rules import withhold_on_the_airspeed
 from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
@@ -29,9 +30,9 @@ from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_par
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns, withhold_on_moving_throttle,
-                                             withhold_thrust_drift)
-from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, note_surface_scale,
-                                          note_untested_coupling,
+                                             withhold_shift_within_thrust, withhold_thrust_drift)
+from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, inertial_alpha_sensors,
+                                          note_surface_scale, note_untested_coupling,
                                           withhold_off_the_integration_drift,
                                           withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
                                           withhold_even_term_off_the_quiet_flight,
@@ -121,6 +122,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         withhold_thrust_drift(cands, p, aero.trim)
     if step.pinned is not None:
         cands.append(pinned_shift(step.pinned, p, aero.trim))
+    withhold_shift_within_thrust(cands, step, p, aero.trim, mismatch, measured)
     withhold_on_moving_throttle(cands, p, propeller)
     withhold_beside_the_accelerometer(cands, step.selections, p, as_evaluated, noise)
     # the rules that keep a term from being named when something else would imitate it
@@ -138,8 +140,10 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     note_untested_coupling(cands, p)
     note_surface_scale(cands)
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}
-    imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0)
-    withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin), contested)
+    for axis, sensors in inertial_alpha_sensors(p).items():
+        column_sensors[axis] = tuple(dict.fromkeys(column_sensors.get(axis, ()) + sensors))
+    imitated = imitation(p, kin, aircraft, ic, mismatch, step, slope_of, V0, sensor_values)
+    withhold_ambiguous(cands, kin, imitated, column_sensors, euler_lag_estimate(p, kin, sensor_values), contested)
     withhold_resting_on_an_uncertain_correction(cands, kin, sensor_values, imitated)
     withhold_on_the_airspeed(cands, p, kin, aircraft, ic, mismatch, step)
     if turbulent:
@@ -166,6 +170,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             withhold_imitated_by_named(cands, imitated, set(sensor_values))
             withhold_delays_imitated_by_named(cands, kin, p, aircraft, ic, aero.derivatives, noise, set(sensor_values))
     name_accelerometer_once(cands)
+    withhold_through_the_inertial_angles(cands, step.selections, p, kin, aircraft, ic, mismatch, sensor_values)
     # 6. spectra and gusts
     peak = structural_peak(p)
     cands += spectral_candidates(peak, gust, turbulent, light, air)

@@ -195,6 +195,39 @@ def pinned_shift(test: CgMeanTest, p: Prepared | None = None, trim: TrimPoint | 
                      details)
 
 
+def withhold_shift_within_thrust(cands: list[Candidate], step: StepwiseFits, p: Prepared, trim: TrimPoint,
+                                 mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> None:
+    """A moment-reference shift C_m's stepwise entered is named only when C_m's mistrim beside
+    its other terms (the constant :func:`shift_mistrim_test` reads) stands two standard errors
+    beyond what the thrust's own moment can make (:func:`thrust_mistrim_bound`), as a shift
+    sized by the mistrim must (:func:`pinned_shift`). Its C_Z column follows α (C_Z is α as the
+    accelerometer measures it, with less noise than the vane, so the stepwise may prefer it to
+    a C_m,α change's α), and only the mistrim tells the two apart; a constant the thrust's
+    moment can make does not. An independent script's T-37 (6,900 ft / 382 ft/s, pitch 3-2-1-1
+    at 100 Hz, metric units) with C_m,α −0.15 had a 0.186 ft shift named (t 20; C_m,α at t 2.9
+    beside it), its C_m constant −0.0042, the thrust's moment through the model's thrust line
+    0.73 ft from the c.g. up to 0.0045."""
+    if "thrust" in p.raw and "thrust_offset_ft" in p.meta:
+        return
+    bound = thrust_mistrim_bound(p, trim)
+    cbar, cz = p.meta["geometry"]["cbar_ft"], float(np.mean(measured["CZ"][interior(p)]))
+    for c in cands:
+        if not (c.selected and c.parameter == "dx_moment_reference" and c.channel == "Cm"
+                and c.test.startswith("stepwise")):
+            continue
+        test = shift_mistrim_test(p, c.estimate, "Cm", step.selections, step.nuisances, mismatch, measured)
+        if test is None:
+            continue
+        mistrim, se = abs(test.dx_ft * cz / cbar), abs(test.std_error_ft * cz / cbar)
+        c.details["thrust_mistrim_bound"] = bound
+        if mistrim - 2.0 * se < bound:
+            c.selected = False
+            c.reason = (f"not named: C_m's mistrim beside its other terms ({mistrim:.2g} ± {se:.1g}) is within what "
+                        f"the thrust's moment through a thrust line {thrust_line_offset(p, trim):.2f} ft from the c.g. "
+                        f"can make ({bound:.2g}; thrust and its line were not recorded): the mean of C_m cannot tell "
+                        "the shift from the C_m,α change its C_Z column imitates")
+
+
 def _without_shift(p: Prepared, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray],
                    dx_ft: float) -> dict[str, np.ndarray]:
     """The mismatch less what a moment-reference shift of ``dx_ft`` puts in it: Δx·C_Z/c̄ in

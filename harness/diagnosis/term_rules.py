@@ -13,7 +13,7 @@ from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import (INERTIAL_CHANNELS, corrected_recording, inertial_beta, interior, model_along,
-                                     rate_derivatives_advanced)
+                                     rate_derivatives_advanced, undriven_inertial)
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import turbulence_test
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
@@ -631,13 +631,16 @@ class EulerLag:
     """What the kinematics say of the lag a simulation's rectangular-Euler step leaves
     between the rates' derivatives and the moments (:func:`euler_lag_estimate`): the gyros'
     lead they read (s; negative: lagging), its |t| and standard error, and the lags they
-    allow, ``low`` to ``high`` (s, within the physical range 0 to half the sample interval)."""
+    allow, ``low`` to ``high`` (s, within the physical range 0 to half the sample interval; to
+    a whole one after a gyro skew was applied, ``after_skew``)."""
 
     tau: float
     t: float
     std_error: float
     low: float
     high: float
+    after_skew: str = ""   # the gyro skew applied to the channels, which took in the step's lead
+    lead_high: float = np.nan  # the largest gyro lead the step itself explains (:func:`euler_lead`)
 
     @property
     def shown(self) -> bool:
@@ -658,7 +661,7 @@ def _gyro_lead(kin: KinematicResult) -> tuple[float, float, float] | None:
     return -unit[0], unit[1], unit[2]
 
 
-def euler_lag_estimate(p: Prepared, kin: KinematicResult) -> EulerLag | None:
+def euler_lag_estimate(p: Prepared, kin: KinematicResult, applied: dict[str, float] | None = None) -> EulerLag | None:
     """The lag of the rates' derivatives behind the moments that a simulation integrating
     rates and attitude by rectangular Euler leaves in its recording, as far as the kinematics
     allow it; None when they rule it out.
@@ -676,7 +679,22 @@ def euler_lag_estimate(p: Prepared, kin: KinematicResult) -> EulerLag | None:
     C_m,α̇ +1.7 to +2.1 (t 6–8; +1.5 noise-free, where the lead is seen at t 164). A gyro
     skew cannot stand for it: shifting the rates moves their derivatives the other way (an
     independent c172x script at 100 Hz, noise-free: the common skew −5 ms, t 360, whose own
-    correction imitated −1.0 of a C_m,α̇ change of +1.66)."""
+    correction imitated −1.0 of a C_m,α̇ change of +1.66).
+
+    Where a rate gyro's skew was applied to the channels (``applied``, the sensor corrections;
+    :func:`applied_gyro_skew`), the kinematics read the sensor's lag less the step's lead, and
+    the correction took the lead in: the corrected rates lag by what it left, up to half a
+    step, and their derivatives the moments by up to a whole step, which the kinematics no
+    longer see. The lags allowed are then 0 to a sample interval and three standard errors of
+    the applied skew (``after_skew`` names it). An independent script's A-4 whose q gyro was
+    40 ms late (9,100 ft / 529 ft/s, pitch 3-2-1-1 in a 33° turn at 100 Hz) had it named at
+    35.0 ± 0.9 ms and beside it a C_m,δe change of −0.021 (4.3 % of C_m's excursion) that the
+    derivatives advanced by half a step take to 3.0 %, and by a whole step out."""
+    skewed = applied_gyro_skew(applied or {})
+    if skewed:
+        se = kinematic_std_error(kin, skewed)
+        se = se if np.isfinite(se) else 0.0
+        return EulerLag(p.dt / 2, 0.0, se, 0.0, p.dt + IMITATION_Z * se, skewed, p.dt / 2 + IMITATION_Z * se)
     lead = _gyro_lead(kin)
     if lead is None:
         return None
@@ -684,11 +702,21 @@ def euler_lag_estimate(p: Prepared, kin: KinematicResult) -> EulerLag | None:
     low, high = max(0.0, tau - IMITATION_Z * se), min(p.dt / 2, tau + IMITATION_Z * se)
     if high <= 0.0 or low > high:
         return None
-    return EulerLag(tau, t, se, low, high)
+    return EulerLag(tau, t, se, low, high, lead_high=high)
+
+
+def applied_gyro_skew(applied: dict[str, float]) -> str:
+    """The rate gyros' skew (their common one, else one gyro's) among the sensor corrections
+    ``applied`` to the channels, '' when none was."""
+    for name in (GYRO_UNIT,) + tuple(f"skew_{g}" for g in GYROS):
+        if applied.get(name):
+            return name
+    return ""
 
 
 def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: InitialCondition,
-              mismatch: dict[str, np.ndarray], step: StepwiseFits, slope_of=None, V0: float | None = None):
+              mismatch: dict[str, np.ndarray], step: StepwiseFits, slope_of=None, V0: float | None = None,
+              applied: dict[str, float] | None = None):
     """``imitated(c, name)``: the largest change of term ``c``'s parameter, in the direction of
     its own change, that sensor error ``name`` imitates anywhere within :data:`IMITATION_Z`
     standard errors of its kinematic estimate; None when it cannot be computed.
@@ -711,6 +739,7 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
     this column alone (probe 22, 5 Dec 2026)."""
     inner = interior(p)
     vane_key = "vane_alpha_noise"
+    follows_inertial_alpha = "alpha" in undriven_inertial(p)
 
     def refit(z: np.ndarray, cols: list[np.ndarray]) -> float:
         A = np.column_stack(cols + [np.ones(z.size)])
@@ -721,7 +750,7 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         direction: per_v·v and IMITATION_Z·|per_v|·σ; v ± σ the kinematic estimate, or ``at``
         (an error named on two tests, at its combined size)."""
         if name == EULER_LAG:  # probed at the largest lag allowed; the interval's ends below
-            lag = euler_lag_estimate(p, kin)
+            lag = euler_lag_estimate(p, kin, applied)
             found = None if lag is None else (lag.high, 1.0, 0.0)
         elif at is not None:
             lag, found = None, (at[0], abs(at[0]) / at[1] if at[1] > 0 else np.inf, at[1])
@@ -737,7 +766,9 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
             corrected = rate_derivatives_advanced(p, v)
         else:
             corrected = corrected_recording(p, kin, {m: v for m in unit_members(kin, name)})
-        changed = model_along(corrected, aircraft, ic, inertial_from=p).mismatch()
+        # an inertial α the model follows is rebuilt from the corrected channels: the error's
+        # own path into the model's states (inertial_alpha_sensors)
+        changed = model_along(corrected, aircraft, ic, inertial_from=None if follows_inertial_alpha else p).mismatch()
         cols = [by_key[key].column[inner]] + [by_key[k].column[inner] for k in sel.names if k != key and k in by_key]
         nuisances = step.nuisances.get(c.channel, {})
         fixed = [x[inner] for n, x in nuisances.items() if n != vane_key and np.ptp(x[inner]) > 0]
@@ -812,6 +843,21 @@ def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: Kin
 # The channels the α vane's error column is integrated from, beyond the gyros and the vane:
 # a skew or scale of theirs is in the column, and through it in the axis's fit.
 VANE_COLUMN_SENSORS = ("az",)
+# The channels the inertial α is integrated from (the w equation: q and a_z), where the model
+# follows it (:func:`along.undriven_inertial`), beyond the vane: a skew of theirs moves the
+# model's α itself, on every axis that reads α (INERTIAL_ALPHA_AXES).
+INERTIAL_ALPHA_SENSORS = ("q", "az")
+INERTIAL_ALPHA_AXES = ("CX", "CZ", "Cm")
+
+
+def inertial_alpha_sensors(p: Prepared) -> dict[str, tuple[str, ...]]:
+    """Per axis, the sensors the model's α is built from where it follows the inertial α
+    (:data:`INERTIAL_ALPHA_SENSORS`; empty otherwise), for :func:`withhold_ambiguous`'s
+    ``column_sensors``: a q gyro 40 ms late on an independent script's 787-8 (pitch sweep at
+    791 ft/s, 40 Hz, twice the vanes' noise; α under the vane's noise, so the model follows
+    the inertial α) put α −τ·q into the model, read as a C_Z,q̂ change of −8.9 (t −7.5) while
+    the kinematics put the skew at 26 ± 26 ms."""
+    return {a: INERTIAL_ALPHA_SENSORS for a in INERTIAL_ALPHA_AXES} if "alpha" in undriven_inertial(p) else {}
 
 
 def _lag_shaped(c: Candidate) -> bool:
@@ -872,7 +918,7 @@ def euler_lead(kin: KinematicResult, name: str, euler_lag: EulerLag | None) -> b
     if found is None:
         return False
     v, _, se = found
-    return v < 0 and -v - IMITATION_Z * se <= euler_lag.high
+    return v < 0 and -v - IMITATION_Z * se <= euler_lag.lead_high
 
 
 def _named(rival: str | tuple[str, ...]) -> str:
@@ -1025,7 +1071,7 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     for c in cands:  # a simulation's integration step: the moments lead the rates' derivatives
         suspected = not c.selected and "suspicion" in c.details  # withheld above: asked too, for the lift
         if not ((c.selected or suspected) and c.channel in MOMENT_AXES and c.test.startswith("stepwise")
-                and _lag_shaped(c)):
+                and (_lag_shaped(c) or _after_skew_reaches(euler_lag, c))):
             continue
         lag = euler_lag
         if suspected:
@@ -1039,6 +1085,12 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             c.selected = False
             c.details["sensor_rival"] = EULER_LAG
             c.details["euler_lag_s"] = [lag.tau, lag.std_error, lag.low, lag.high]
+            if lag.after_skew:
+                c.reason = (f"entered, but not named: the {lag.after_skew} applied to the channels took in the lead "
+                            "a simulation integrating by rectangular Euler gives the rates; their derivatives, from "
+                            f"which {c.channel} is built, may then lag the moments by up to {1000 * lag.high:.1f} ms, "
+                            "which imitates this term")
+                continue
             read = (f"read the rate gyros as leading the attitude by {1000 * lag.tau:.1f} ± "
                     f"{1000 * lag.std_error:.1f} ms (t = {lag.t:.1f})" if lag.shown else
                     f"do not rule out the rate gyros leading the attitude by up to {1000 * lag.high:.1f} ms "
@@ -1046,6 +1098,17 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             c.reason = (f"entered, but not named: the kinematics {read}, as a simulation integrating by "
                         f"rectangular Euler records them; the rates' derivatives, from which {c.channel} is built, "
                         "then lag the moments by as much, which imitates this term")
+
+
+# The moment axes each rate gyro's skew reaches through its derivative.
+GYRO_AXES = {"skew_p": ("Cl", "Cn"), "skew_q": ("Cm",), "skew_r": ("Cl", "Cn"), GYRO_UNIT: MOMENT_AXES}
+
+
+def _after_skew_reaches(lag: EulerLag, c: Candidate) -> bool:
+    """Whether the lag a gyro skew's correction leaves (:func:`euler_lag_estimate`) is asked of
+    term ``c`` whatever its shape: every term of the moment axes that gyro's derivative builds
+    (a whole step's lag of q̇ reaches C_m,δe beside the δe delay column it also enters)."""
+    return bool(lag.after_skew) and c.channel in GYRO_AXES.get(lag.after_skew, ())
 
 
 def _suspicion(rival: str, t: float, contest_at: dict[str, tuple[float, float]]) -> dict:
