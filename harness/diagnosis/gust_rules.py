@@ -32,9 +32,9 @@ def air_share_test(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along:
     follows the inertial α (:func:`model_states`, :func:`along.undriven_inertial`), and is
     evaluated again along the vane for the test. (Along the inertial α the mismatch carries
     none of the vane's wander, whatever the difference e is, and the share reads 1: an
-    independent script's 787-8 null, pitch sweep at 791 ft/s and 27,500 ft with twice the
-    vanes' wander at 40 Hz, α under the vane's noise, had turbulence of 4.8 ft/s named at an
-    air share of 1.01 ± 0.03.)"""
+    independent script's 787-8, pitch sweep at 791 ft/s and 27,500 ft with twice the vanes'
+    wander at 40 Hz, α under the vane's noise, q resampled 40 ms late and back, had
+    turbulence of 4.8 ft/s named at an air share of 1.01 ± 0.03; along the vane 0.25.)"""
     vane_alpha = "alpha" in p.driven or "alpha" in p.moved
     if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0 or not vane_alpha:
         along = model_along(p, aircraft, ic, vanes=True)
