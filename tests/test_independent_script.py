@@ -784,3 +784,18 @@ def test_an_accelerometer_position_reaches_the_lateral_terms_through_the_inertia
     assert [p for p, _ in _found(result)] in (["x_accelerometer"], ["offset_x"])
     term = next(c for c in result["candidates"] if c["parameter"] == "Cl_rhat")
     assert not term["selected"], term["reason"]
+
+
+def test_the_airspeed_error_in_a_rate_term_s_place_is_read_with_the_kinematics_sign(tmp_path):
+    """The package's c182 (5,700 ft / 185 ft/s, doublets on each axis at 50 Hz, half the noise)
+    with its airspeed 10 ft/s high: a C_l,p̂ change of −0.021 was named (t −25). Fitted in its
+    place the airspeed signature (what correcting V by a bias changes) asked for −7.7 times
+    itself, a bias of +7.7 ft/s, which was compared with the kinematics' +5.7 ± 2.0 as −7.7
+    (airspeed_rules.withhold_on_the_airspeed): the term is withheld, the bias read high."""
+    model = _package_xml("c182")
+    rec, val = _pair(tmp_path, "c182", 5723.0, 185.3, 696, 50.0, "dbl3", units="deg", noise=0.5, amplitude_deg=3.22)
+    for path in (rec, val):
+        _sensor_error(path, "V_fps", lambda t, x: x + 10.0)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    term = next(c for c in result["candidates"] if c["parameter"] == "Cl_phat")
+    assert not term["selected"] and "airspeed error of +" in term["reason"], term["reason"]

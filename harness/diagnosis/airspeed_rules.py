@@ -88,7 +88,9 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
                                            ["term", "airspeed"] + [f"o{i}" for i in range(len(others))])
         except (SingularRegressorsError, np.linalg.LinAlgError):
             continue
-        u, t_term = float(alone[0]), float(both[0] / se_both[0]) if se_both[0] > 0 else 0.0
+        # the signature is what correcting the channels by a bias changes, so a recorded bias b
+        # puts −b times it into the mismatch: the bias the fit says is minus its coefficient
+        u, t_term = -float(alone[0]), float(both[0] / se_both[0]) if se_both[0] > 0 else 0.0
         plausible = abs(u) <= PLAUSIBLE["scale"]["V"] * V0
         allowed = np.isfinite(se) and abs(u - v) <= IMITATION_Z * se
         c.details["beside_the_airspeed"] = {"bias_fps": u, "t": t_term}
