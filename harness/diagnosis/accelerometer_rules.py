@@ -9,7 +9,7 @@ import numpy as np
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.along import corrected_recording, inertial_beta, model_along, undriven_inertial
+from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along, undriven_inertial
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.prepare import Prepared, interior_slice
 from harness.diagnosis.term_rules import left_impractical, term_change
@@ -154,7 +154,7 @@ def withhold_through_the_inertial_angles(cands: list[Candidate], selections: dic
         return
     corrected = corrected_recording(p, kin, {**applied, "offset_x": named.estimate})
     changed = model_along(corrected, aircraft, ic).mismatch()
-    inner = interior_slice(p.n, p.dt)
+    inner = interior(p)
     for c in terms:
         sel, by_key = selections.get(c.channel, (None, {}))
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
