@@ -60,11 +60,14 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
     its nuisance columns); when the airspeed error so sized is one an instrument could make
     (within :data:`kinematics.PLAUSIBLE`'s 10 % of V for an airspeed scale, which over a
     maneuver that hardly moves V is the same error) and lies within
-    :data:`term_rules.IMITATION_Z` standard errors of the kinematics' bias estimate, and the
-    term fitted beside the signature falls below the entry t (:data:`candidates.T_IN`), it is
-    withheld. An independent script's pa28 (154 ft/s, lateral sweep at 50 Hz) with V 10 ft/s
-    high had a C_l,p̂ change of −0.026 on −0.47 named (t −17); the kinematics put the bias at
-    −3.2 ± 4.8 ft/s."""
+    :data:`term_rules.IMITATION_Z` standard errors of the kinematics' bias estimate (the two
+    estimates' colored standard errors taken together, as independent), and the term fitted
+    beside the signature falls below the entry t (:data:`candidates.T_IN`), it is withheld.
+    An independent script's pa28 (154 ft/s, lateral sweep at 50 Hz) with V 10 ft/s high had
+    a C_l,p̂ change of −0.026 on −0.47 named (t −17); the kinematics put the bias at −3.2 ±
+    4.8 ft/s. A c182 (185 ft/s, three-axis doublets) with V 10 ft/s high had
+    C_m,α̇ −1.26 named (t −9): the signature asks +12.6 ± 1.4 ft/s in its place, the
+    kinematics +5.7 ± 2.0, 3.4 of the kinematics' standard errors apart but 2.8 of both."""
     terms = [c for c in cands if c.selected and c.test.startswith("stepwise") and normalised_by_airspeed(c)]
     found = kinematic_estimate(kin, AIRSPEED_BIAS)
     if not terms or found is None:
@@ -82,8 +85,8 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
         others += [x[inner] for x in step.nuisances.get(c.channel, {}).values() if np.ptp(x[inner]) > 0]
         z = mismatch[c.channel][inner]
         try:
-            # the error's size in the term's place (its standard error is not needed)
-            alone = np.linalg.lstsq(np.column_stack([sig] + others + [np.ones(z.size)]), z, rcond=None)[0]
+            # the error's size in the term's place, with its own colored standard error
+            alone, se_alone, _ = colored_fit(z, [sig] + others, ["airspeed"] + [f"o{i}" for i in range(len(others))])
             both, se_both, _ = colored_fit(z, [by_key[key].column[inner], sig] + others,
                                            ["term", "airspeed"] + [f"o{i}" for i in range(len(others))])
         except (SingularRegressorsError, np.linalg.LinAlgError):
@@ -92,12 +95,14 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
         # puts −b times it into the mismatch: the bias the fit says is minus its coefficient
         u, t_term = -float(alone[0]), float(both[0] / se_both[0]) if se_both[0] > 0 else 0.0
         plausible = abs(u) <= PLAUSIBLE["scale"]["V"] * V0
-        allowed = np.isfinite(se) and abs(u - v) <= IMITATION_Z * se
-        c.details["beside_the_airspeed"] = {"bias_fps": u, "t": t_term}
+        spread = float(np.hypot(se, se_alone[0]))
+        allowed = np.isfinite(spread) and abs(u - v) <= IMITATION_Z * spread
+        c.details["beside_the_airspeed"] = {"bias_fps": u, "std_error": float(se_alone[0]), "t": t_term}
         if not (plausible and allowed and abs(t_term) < cand.T_IN):
             continue
         c.selected = False
         c.details["sensor_rival"] = AIRSPEED_BIAS
-        c.reason = (f"entered, but not named: an airspeed error of {u:+.3g} ft/s ({100 * u / V0:+.1f} % of V; the "
-                    f"kinematics allow {v:.3g} ± {IMITATION_Z:g}·{se:.2g}), normalising the rates, fits the "
+        c.reason = (f"entered, but not named: an airspeed error of {u:+.3g} ± {se_alone[0]:.2g} ft/s "
+                    f"({100 * u / V0:+.1f} % of V; the kinematics put it at {v:.3g} ± {se:.2g}, within "
+                    f"{IMITATION_Z:g} of the two standard errors together), normalising the rates, fits the "
                     f"mismatch in its place, and beside it this term stands at t = {t_term:.1f}")

@@ -41,6 +41,7 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane,
                                           withhold_resting_on_an_uncertain_correction, withhold_rivals)
+from harness.diagnosis.wander_rules import withhold_within_the_unseen_wander
 from models.aircraft import Aircraft, has_propeller
 from models.replay import InitialCondition
 
@@ -135,6 +136,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_even_term_off_the_quiet_flight(cands, step, p, mismatch)
     withhold_force_drift_off_the_vane_wander(cands, step, p, mismatch, slope_of, wander_gust, V0)
     withhold_off_the_integration_drift(cands, step, p, mismatch)
+    withhold_within_the_unseen_wander(cands, step, p, mismatch)
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
                     measured)
     note_untested_coupling(cands, p)

@@ -23,6 +23,16 @@ from models.hidden import SENSOR_EFFECTS
 # the identification's entry t to be named on the two together (:func:`name_replicated`):
 # the suspicion level of the other sensor rules (:data:`AMBIGUOUS_T`).
 REPLICATED_EACH_T = AMBIGUOUS_T
+# The biases :func:`name_replicated` names: the inertial instruments' (accelerometers, rate
+# gyros), each a constant added in its own kinematic equations. An air-data bias (the
+# airspeed, a vane) enters them multiplied by the motion (an airspeed bias b puts q·b into
+# the ẇ equation, −r·b into the v̇ one), so an error the kinematics leave out, the vane's
+# noise passed through those products among them, repeats in both records as it would: an
+# independent script's t6texan2 (11,900 ft / 378 ft/s, 30° bank, multisine on each axis and
+# doublets, half the noise) had an airspeed bias of −12.9 ± 3.7 and −12.7 ± 2.4 ft/s on
+# its two maneuvers and none recorded; five other noise draws of the same flights gave
+# +1.1 to −13.9 (mean −5, scatter 5), the noise-free flights −0.01.
+REPLICATED_BIASES = tuple(f"bias_{c}" for c in ("ax", "ay", "az", "p", "q", "r"))
 
 
 def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
@@ -38,7 +48,8 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
     r between 0.7 and 0.9), or when the combined size is not practical and precise
     (:func:`sensor_verdict`). Returns the candidates of ``a`` it selected.
 
-    Biases only, and only when no other sensor error is named: the replication shows the two
+    The inertial instruments' biases only (:data:`REPLICATED_BIASES`), and only when no
+    other sensor error is named: the replication shows the two
     records' noise to be independent, not their systematic errors. A real error the kinematic
     fit leaves out repeats in both records and pushes the columns that follow the same motion
     alike: beside a β-vane scale of 0.15 (named on the coefficient mismatch, not in the
@@ -55,7 +66,7 @@ def name_replicated(a: Analysis, av: Analysis) -> list[Candidate]:
     named = []
     for c in a.candidates:
         v = twins.get(c.parameter)
-        if (c.selected or v is None or c.reason != "below the entry t" or c.effect != "sensor_bias"
+        if (c.selected or v is None or c.reason != "below the entry t" or c.parameter not in REPLICATED_BIASES
                 or min(abs(c.t), abs(v.t)) < REPLICATED_EACH_T or np.sign(c.estimate) != np.sign(v.estimate)
                 or c.std_error <= 0 or v.std_error <= 0):
             continue

@@ -5,8 +5,8 @@ collinear with it would have done almost as well, and when the two stand for dif
 physics (a C_m,α change and a moment-reference shift, whose column C_Z(t) follows α) the
 choice is a coin toss the report must not present as a finding. Two kinds of rival:
 
-* **A collinear candidate** on the same axis (correlation of the columns over the
-  maneuver's interior at least :data:`RIVAL_CORRELATION`). The term is named only when it
+* **A correlated candidate** on the same axis (correlation of the columns over the
+  maneuver's interior at least :data:`TERM_RIVAL_CORRELATION`). The term is named only when it
   stays significant with the rival in the fit, |t| >= the entry t
   (:data:`harness.diagnosis.candidates.T_IN`). Its rival's size when fitted *in its place*
   is kept, so that the validation maneuver can say which of the two predicts better
@@ -37,6 +37,17 @@ from estimators.result import COLLINEARITY_LIMIT
 # Columns correlated at least this much are rivals: the seed's collinearity limit (§III.G,
 # pairwise |r| > 0.9 marks regressors whose estimates the data cannot separate).
 RIVAL_CORRELATION = COLLINEARITY_LIMIT
+# A same-axis candidate this correlated with a selected term is asked as its rival in the
+# coefficient mismatch (:func:`harness.diagnosis.term_rules.withhold_rivals`): from here its
+# column at least doubles the term's variance (1 / (1 − r²) ≥ 2), and whether the term then
+# stands is its t beside it, not r. The seed's 0.9 is for white residuals and columns without
+# noise; the mismatch's residual is colored, and a column built on a noisy channel correlates
+# less with its rival than the clean signals do. An independent script's c172x (171.6 ft/s,
+# three-axis multisine at 40 Hz) with C_m,q̂ −4 had C_m,δe +0.105 named (t 8.5): its column
+# and q̂'s correlated −0.81 on that maneuver, and beside each other neither stood (t 2.8
+# and −2.7); on the doublet validation maneuver they correlated −0.99. The kinematic check's
+# gate is the same (:data:`harness.diagnosis.sensor_rules.KINEMATIC_RIVAL_CORRELATION`).
+TERM_RIVAL_CORRELATION = 0.7
 # A vane bias is ruled out by the kinematics only when it lies more than this many of their
 # standard errors from their estimate.
 KINEMATIC_Z = 3.0
