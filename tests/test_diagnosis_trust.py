@@ -354,8 +354,8 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
     0.027 ± 0.0042 (t 6.3 there, but below the entry t on the identification) is named at
     their inverse-variance combination; opposite signs, sizes more than two standard errors
     apart, a combined t under the entry t, or one maneuver below the suspicion level name
-    nothing; nor a scale (a column that follows the motion), nor anything when another sensor
-    error is named."""
+    nothing; nor a scale or an air-data bias (columns that follow the motion), nor anything
+    when another sensor error is named."""
     from types import SimpleNamespace
 
     from harness.diagnosis import replication
@@ -386,6 +386,10 @@ def test_a_sensor_error_each_maneuver_only_suspects_is_named_on_the_two(monkeypa
     scale = analysis(0.027, 0.0058)
     scale.candidates[0].effect = "sensor_scale"  # a column that follows the motion: not replicated
     assert name_replicated(scale, analysis(0.0266, 0.0042)) == []
+    airspeed, airspeed_v = analysis(-12.9, 3.7), analysis(-12.7, 2.4)
+    for x in (airspeed, airspeed_v):  # an air-data bias enters the kinematics times the motion
+        x.candidates[0].parameter, x.candidates[0].channel = "bias_V", "V"
+    assert name_replicated(airspeed, airspeed_v) == []
     for v, se in [(-0.0266, 0.0042),   # opposite sign
                   (0.06, 0.0042),      # (0.060 - 0.027) / hypot(.0058, .0042) = 4.6 > 2 standard errors apart
                   (0.0126, 0.0042),    # t 3: combined 0.018 ± 0.0034, t 5.3 < 6

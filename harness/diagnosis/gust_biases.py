@@ -16,6 +16,10 @@ from harness.diagnosis.sensor_rules import kinematic_estimate
 from harness.diagnosis.spectra import GustEstimate
 
 
+# The kinematic scale factors corrected with the biases before the gust test is asked again.
+VANE_SCALES = ("scale_alpha", "scale_beta")
+
+
 def gusts_without_biases(p: Prepared, kin: KinematicResult, V0: float) -> tuple[GustEstimate, dict[str, float]] | None:
     """The gust estimate on the channels corrected for the biases the kinematic check finds
     (its always-fitted biases, ``kin.forced``, at the kinematic entry t and plausible sizes:
@@ -27,9 +31,14 @@ def gusts_without_biases(p: Prepared, kin: KinematicResult, V0: float) -> tuple[
     integrated residual that follows the maneuver as the bias's own kinematic signature does.
     (An A-4 in a 3-2-1-1 on each axis at 546 ft/s with its β vane 1° off read light
     turbulence of 2.3 ft/s, the vertical gust following the bank it rolled through, and the
-    β bias the kinematics put at t 16 was not applied.)"""
+    β bias the kinematics put at t 16 was not applied.) A vane's scale factor, when the
+    kinematics select it, is the same kind of error (:data:`VANE_SCALES`): k times the
+    vane's own angle, it takes only the part of the residual that follows that angle. (A
+    c172x in a 3-2-1-1 on each axis at 163 ft/s with its β vane reading 15 % high read light
+    turbulence, the side 'gust' following β, and named it; the scale the kinematics put at
+    0.156, t 16, was not applied.)"""
     biases = {}
-    for name in kin.forced:
+    for name in kin.forced + tuple(n for n in kin.selection.names if n in VANE_SCALES):
         found = kinematic_estimate(kin, name)
         if found is not None and found[1] >= KIN_T_IN and is_plausible(name, found[0], V0):
             biases[name] = found[0]
