@@ -112,6 +112,8 @@ def _axis_dict(a: AxisRatio) -> dict:
     out = {"ratio": a.ratio, "std_error": a.std_error}
     if a.imitator:
         out |= {"imitator": a.imitator, "imitator_r": a.imitator_r, "share": a.share}
+    if np.all(np.isfinite(a.beside_imitator)):
+        out["beside_imitator"] = {"t_signature": a.beside_imitator[0], "t_term": a.beside_imitator[1]}
     if np.isfinite(a.mean):
         out |= {"mean": a.mean, "mean_std_error": a.mean_se, "signature_mean": a.signature_mean}
     return out
