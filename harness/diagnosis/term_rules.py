@@ -217,6 +217,20 @@ def withhold_force_drift_off_the_vane_wander(cands: list[Candidate], step: Stepw
 VANE_COLUMN_CHECK_HZ = 0.1
 
 
+def terms_beside_the_vane_column(cands: list[Candidate], step: StepwiseFits):
+    """The selected terms of the axes fitted with the α vane's error column
+    (``vane_alpha_noise``, :func:`stepwise_axes.vane_noise_columns`): for each, the candidate,
+    its axis's selection and terms by key, the term's key and the axis's nuisance columns."""
+    for c in cands:
+        nuisances = step.nuisances.get(c.channel or "", {})
+        if not (c.selected and "vane_alpha_noise" in nuisances and c.channel in step.selections):
+            continue
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
+        if key is not None:
+            yield c, sel, by_key, key, nuisances
+
+
 def withhold_off_the_integration_drift(cands: list[Candidate], step: StepwiseFits, p: Prepared,
                                        mismatch: dict[str, np.ndarray]) -> None:
     """A term entered beside the α vane's error column (``vane_alpha_noise``,
@@ -231,14 +245,7 @@ def withhold_off_the_integration_drift(cands: list[Candidate], step: StepwiseFit
     that record's inertial angle alone, noise-free vane, fitted α² at R² 0.4."""
     inner = interior(p)
     b, a = butter(2, VANE_COLUMN_CHECK_HZ, btype="highpass", fs=1.0 / p.dt)
-    for c in cands:
-        nuisances = step.nuisances.get(c.channel or "", {})
-        if not (c.selected and "vane_alpha_noise" in nuisances and c.channel in step.selections):
-            continue
-        sel, by_key = step.selections[c.channel]
-        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
-        if key is None:
-            continue
+    for c, sel, by_key, key, nuisances in terms_beside_the_vane_column(cands, step):
         others = [by_key[k].column[inner] for k in sel.names if k in by_key and k != key]
         others += [v[inner] for n, v in nuisances.items() if n != "vane_alpha_noise" and np.ptp(v[inner]) > 0]
         quick = filtfilt(b, a, nuisances["vane_alpha_noise"])
