@@ -12,7 +12,8 @@ from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_be
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
 from harness.diagnosis.gust_biases import gusts_without_biases, note_gusts_of_biases
-from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_test, gust_verdict, light_gusts,
+from harness.diagnosis.gust_rules import (LIGHT_TURBULENCE_FACTOR, air_share_test, gust_verdict,
+                                          gusts_of_an_airspeed_bias, light_gusts,
                                           spectral_candidates, turbulence_test, vane_wander, withhold_in_light_gusts,
                                           withhold_in_turbulence, withhold_vane_wander)
 from harness.diagnosis.gusts import process_noise_model
@@ -103,6 +104,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     near = near if not sensor_values else ""  # a corrected recording is not asked again
     air = air_share_test(p, aircraft, ic, along, slope_of, gust, V0) if turbulent or gusty or near else None
     turbulent, light, gusty = gust_verdict(gust, air, turbulent, gusty, V0, near)
+    airspeed = gusts_of_an_airspeed_bias(recorded, gust, V0) if turbulent or light else ""
+    if airspeed:  # the 'gust' is an airspeed error's signature: neither named, the sensor tests void
+        turbulent, light, gusty = False, False, airspeed
     cands = kinematic_candidates(kin, recorded, turbulent, plausible, gusty)
     withhold_biases_an_airspeed_bias_makes(cands, kin)
     note_refuted_positions(cands, refuted)

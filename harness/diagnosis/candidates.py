@@ -402,20 +402,36 @@ class OffsetRival:
 OFFSET_RIVAL_CORRELATION = 0.3
 
 
+def offset_rival_columns(reg: dict[str, np.ndarray], inner: slice) -> list[tuple[tuple[str, str], ...]]:
+    """The coefficient errors :func:`offset_rival` tries beside the accelerometer's position,
+    as (force axis, regressor) columns: each force axis's own derivatives
+    (:data:`OWN_REGRESSORS`) alone, and each longitudinal one on C_X and C_Z together, a
+    change of lift (or drag) along it, which the body axes share by the angle of attack
+    (C_X = C_L sin α − C_D cos α, C_Z = −C_L cos α − C_D sin α)."""
+    moved = [r for r in reg if np.ptp(reg[r][inner]) > 0]
+    out = [((axis, r),) for axis in FORCE_AXES for r in OWN_REGRESSORS["lon" if axis in LON else "lat"]
+           if r in moved]
+    return out + [(("CX", r), ("CZ", r)) for r in OWN_REGRESSORS["lon"] if r in moved]
+
+
 def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
                  off: OffsetTest) -> OffsetRival | None:
-    """The coefficient error (a force axis's own derivative, :data:`OWN_REGRESSORS`) the
-    force mismatch cannot tell from the accelerometer's position (:func:`accelerometer_offset`):
-    fitted beside it, the position's strongest component falls below the entry t, unless it
-    stays at :data:`AMBIGUOUS_T` while the derivative falls below that (the data still prefer
-    the position: the kinematic rivals' rule, ``sensor_rules.contested_parameters``); the one
+    """The coefficient error (:func:`offset_rival_columns`) the force mismatch cannot tell
+    from the accelerometer's position (:func:`accelerometer_offset`): fitted beside it, the
+    position's strongest component falls below the entry t, unless it stays at
+    :data:`AMBIGUOUS_T` while the error's columns fall below that (the data still prefer the
+    position: the kinematic rivals' rule, ``sensor_rules.contested_parameters``); the one
     that takes most from the position. An accelerometer ahead of the c.g. adds x·ṙ/g to a_y,
     and on a lateral maneuver ṙ follows β and the rudder: a C_Y,β 0.3 more negative, flown
     into F-16 XML copies (5° lateral multisines), read as an accelerometer 2.2 ft aft at
     10,000 ft / 427 ft/s (t −8.0; beside C_Y,β −1.4, C_Y,β −7.2 beside it) and 2.9 ft aft at
     20,000 ft / 600 ft/s (t −10.5; −1.6 and −2.7). True offsets of 5 and 10 ft on the sweeps'
     pitch and three-axis maneuvers kept t 3.7-10 beside every derivative, none of which
-    reached |t| 2.1 beside them. None when there is no such term."""
+    reached |t| 2.1 beside them. An independent script's F-16 with C_L,α 0.5 higher
+    (7,300 ft / 482 ft/s, pitch 3-2-1-1 at 40 Hz) read as an accelerometer 10.9 ft aft
+    (t −6.6): beside C_Z,α alone it stood at −5.2, beside C_X,α and C_Z,α together at −1.5
+    (they at −11 and −17); on 36 probe recordings with the accelerometer 4 ft ahead it stayed
+    at t 3.7-22 beside that pair. None when there is no such error."""
     k = int(np.argmax(np.abs(off.t)))
     if not np.isfinite(off.std_error_ft[k]):
         return None
@@ -427,22 +443,21 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
     others = [X[a] for a in keep if a != name] + I
     reg = regressors(p)
     best = None
-    for axis in axes:
-        for r in OWN_REGRESSORS["lon" if axis in LON else "lat"]:
-            if r not in reg or np.ptp(reg[r][inner]) <= 0:
-                continue
-            col = np.concatenate([reg[r][inner] / noise[c] if c == axis else np.zeros(m) for c in axes])
-            corr = partial_correlation(X[name], col, others)
-            if abs(corr) < OFFSET_RIVAL_CORRELATION:
-                continue
-            try:
-                theta, se, _ = colored_fit(Z, [X[a] for a in keep] + I + [col], keep + list(axes) + ["rival"],
-                                           constant=False)
-            except (SingularRegressorsError, np.linalg.LinAlgError):
-                continue
-            j = keep.index(name)
-            t_off, t_rival = float(theta[j] / se[j]), float(theta[-1] / se[-1])
-            prefers_offset = abs(t_off) >= AMBIGUOUS_T and abs(t_rival) < AMBIGUOUS_T
-            if abs(t_off) < T_IN and not prefers_offset and (best is None or abs(t_off) < abs(best.t_offset)):
-                best = OffsetRival(f"{axis}_{r}", corr, t_off, t_rival)
+    for pairs in offset_rival_columns(reg, inner):
+        cols = [np.concatenate([reg[r][inner] / noise[c] if c == axis else np.zeros(m) for c in axes])
+                for axis, r in pairs]
+        corr = max((partial_correlation(X[name], col, others) for col in cols), key=abs)
+        if abs(corr) < OFFSET_RIVAL_CORRELATION:
+            continue
+        try:
+            theta, se, _ = colored_fit(Z, [X[a] for a in keep] + I + cols,
+                                       keep + list(axes) + [f"rival{i}" for i in range(len(cols))], constant=False)
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            continue
+        j, n = keep.index(name), len(cols)
+        t_off = float(theta[j] / se[j])
+        t_rival = max((float(v) for v in theta[-n:] / se[-n:]), key=abs)
+        prefers_offset = abs(t_off) >= AMBIGUOUS_T and abs(t_rival) < AMBIGUOUS_T
+        if abs(t_off) < T_IN and not prefers_offset and (best is None or abs(t_off) < abs(best.t_offset)):
+            best = OffsetRival(" and ".join(f"{axis}_{r}" for axis, r in pairs), corr, t_off, t_rival)
     return best

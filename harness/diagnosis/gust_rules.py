@@ -8,7 +8,7 @@ import numpy as np
 from harness.diagnosis.along import ModelAlong, model_along, slope_function
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import kinematic_residuals
-from harness.diagnosis.prepare import Prepared
+from harness.diagnosis.prepare import Prepared, interior_slice
 from harness.diagnosis.spectra import AirShare, FISHER_P, air_share, gust_estimate
 from models.aircraft import Aircraft
 from models.constants import G0_FPS2
@@ -22,6 +22,52 @@ def turbulence_test(p: Prepared):
                          0.5 * (p.noise_std.get("az", 0.03) + p.noise_std.get("ay", 0.03)) * G0_FPS2)
     turbulent = gust.ratio_to_noise >= GUST_RATIO and max(gust.sigma_w_fps, gust.sigma_v_fps) >= GUST_MIN_FPS
     return gust, turbulent
+
+
+def airspeed_bias_in_the_gust(p: Prepared, gust) -> tuple[float, float]:
+    """``(b, R²)``: the vertical gust estimate (``gust.w_fps``, from ``p.raw``) fitted, with a
+    constant, on the change an airspeed bias of 1 ft/s makes to it, over the interior.
+
+    The w equation's residual takes V in w = V sin α cos β and in q·u: a bias b leaves
+    b·(α̇ − q) there (wings level), whose integral, the "gust", is b times the change of the
+    flight-path angle, −b·Δγ. An altitude channel sees the same bias in ḣ (b·sin γ); without
+    one the two are one column."""
+    raw = dict(p.raw)
+    raw["V"] = raw["V"] + 1.0
+    column = gust_estimate(kinematic_residuals(raw, p), p, 1.0).w_fps - gust.w_fps
+    inner = interior_slice(p.n, p.dt)
+    y, A = gust.w_fps[inner], np.column_stack([column[inner], np.ones(inner.stop - inner.start)])
+    theta, *_ = np.linalg.lstsq(A, y, rcond=None)
+    left = float(np.sum((y - A @ theta) ** 2))
+    total = float(np.sum((y - np.mean(y)) ** 2))
+    return float(theta[0]), (1.0 - left / total) if total > 0 else 0.0
+
+
+def gusts_of_an_airspeed_bias(p: Prepared, gust, V0: float) -> str:
+    """Why the gusts found are not named turbulence ('' when they may be): the vertical gust
+    estimate follows an airspeed bias's signature (:func:`airspeed_bias_in_the_gust`), R² at
+    least :data:`AIRSPEED_GUST_R2`, at a size under :data:`AIRSPEED_ERROR_SHARE` of the
+    airspeed. Turbulence is independent of the maneuver; an airspeed error makes a "gust"
+    that is the flight path's own change. An independent script's J3 Cub (1,400 ft / 106
+    ft/s, pitch 3-2-1-1 at 50 Hz, no altitude channel) with the airspeed reading 10 ft/s high
+    had light turbulence of 0.52 ft/s named (air share 0.95 ± 0.05): its gust followed the
+    signature at R² 0.92 as a bias of 10.9 ft/s. On the two sweeps no recording reaches R² 0.5
+    at such a size (turbulence of severity 1-4: 0.02-0.27, at 30-160 ft/s)."""
+    b, r2 = airspeed_bias_in_the_gust(p, gust)
+    if r2 < AIRSPEED_GUST_R2 or abs(b) > AIRSPEED_ERROR_SHARE * V0:
+        return ""
+    return (f"the vanes and the inertial channels disagree, but the vertical 'gust' ({gust.sigma_w_fps:.2f} ft/s) "
+            f"follows the flight path's own change as an airspeed bias of {b:+.1f} ft/s would (R² = {r2:.2f}): not "
+            "turbulence, and not named as an airspeed error either (the kinematics cannot tell it from a gust that "
+            "follows the maneuver); it breaks the kinematic consistency the sensor tests rest on")
+
+
+# The vertical gust is an airspeed error's signature (gusts_of_an_airspeed_bias) when the
+# signature explains at least half its variance, at a size under a fifth of the airspeed
+# (a pitot-static system further off is broken, not biased; lateral maneuvers' small w
+# residuals follow the signature at R² 0.5-0.99 only as "biases" of 0.55-1.03 times V).
+AIRSPEED_GUST_R2 = 0.5
+AIRSPEED_ERROR_SHARE = 0.2
 
 
 def air_share_test(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along: ModelAlong, slope_of, gust,

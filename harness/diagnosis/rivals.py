@@ -69,14 +69,16 @@ class Rival:
     swapped: float       # the rival's coefficient fitted in the term's place
 
 
-def _t_pair(z: np.ndarray, others: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+def t_pair(z: np.ndarray, others: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """The colored t of ``a`` and of ``b`` fitted together in ``z`` beside ``others`` and a constant."""
     theta, se, _ = colored_fit(z, others + [a, b], [f"o{i}" for i in range(len(others))] + ["a", "b"])
     j = len(others)
     return (float(theta[j] / se[j]) if se[j] > 0 else np.inf,
             float(theta[j + 1] / se[j + 1]) if se[j + 1] > 0 else np.inf)
 
 
-def _coefficient(z: np.ndarray, others: list[np.ndarray], col: np.ndarray) -> float:
+def coefficient_beside(z: np.ndarray, others: list[np.ndarray], col: np.ndarray) -> float:
+    """The least-squares coefficient of ``col`` in ``z`` beside ``others`` and a constant."""
     A = np.column_stack(others + [col, np.ones(z.size)])
     theta, *_ = np.linalg.lstsq(A, z, rcond=None)
     return float(theta[len(others)])
@@ -98,12 +100,19 @@ def strongest_rival(z: np.ndarray, columns: Mapping[str, np.ndarray], term: str,
         if abs(corr) < min_correlation:
             continue
         try:
-            t_term, t_rival = _t_pair(z, rest, a, b)
+            t_term, t_rival = t_pair(z, rest, a, b)
         except (SingularRegressorsError, np.linalg.LinAlgError):
             t_term, t_rival = 0.0, 0.0
         if best is None or abs(t_term) < abs(best.t_term):
-            best = Rival(r, corr, t_term, t_rival, _coefficient(z, rest, b))
+            best = Rival(r, corr, t_term, t_rival, coefficient_beside(z, rest, b))
     return best
+
+
+# A slope that varies by less than this (per rad) along the maneuver is no slope: a bias of
+# any plausible size moves the coefficient by less than 1e-9 with it. An independent script's
+# A-4 (C_n does not depend on α in its model) had a C_n α·β coupling at t 52 withheld for an
+# α-vane bias of −0.00° beside a C_n,α "slope" of 1e-13 per rad, the finite difference's rounding.
+SLOPE_FLOOR = 1e-8
 
 
 @dataclass(frozen=True)
@@ -129,13 +138,15 @@ def bias_rival(z: np.ndarray, term_column: np.ndarray, others: list[np.ndarray],
     ``slope`` is the model's ∂C/∂x along the states (per rad); the mismatch a bias Δx makes
     is ``−slope·Δx``, so the bias is minus the slope column's coefficient. ``kinematic`` is
     the kinematic check's (estimate, standard error) of the same bias. None when the slope
-    does not vary along the maneuver (a constant: the intercept already absorbs it)."""
-    if np.ptp(slope) <= 1e-9 * max(float(np.max(np.abs(slope))), 1e-300):
+    does not vary along the maneuver (a constant: the intercept already absorbs it), or varies
+    by less than :data:`SLOPE_FLOOR` (a coefficient that does not depend on the angle at all,
+    its slope the finite difference's rounding)."""
+    if np.ptp(slope) <= max(1e-9 * float(np.max(np.abs(slope))), SLOPE_FLOOR):
         return None
     try:
-        t_term, _ = _t_pair(z, others, term_column, slope)
+        t_term, _ = t_pair(z, others, term_column, slope)
     except (SingularRegressorsError, np.linalg.LinAlgError):
         t_term = 0.0
-    bias = -_coefficient(z, others, slope)
+    bias = -coefficient_beside(z, others, slope)
     return BiasRival(channel, bias, t_term, float(kinematic[0]), float(kinematic[1]))
 

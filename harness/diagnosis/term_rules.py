@@ -467,12 +467,61 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                                   kinematic_bias_of(kin, x, applied))
             if (b is not None and abs(b.t_term) < cand.T_IN and not b.ruled_out
                     and is_plausible(f"bias_{x}", b.bias_rad, V0)):
-                c.selected = False
-                c.details["sensor_rival"] = f"bias_{x}"
-                c.reason = (f"entered, but not named: a {x} vane bias of {np.degrees(b.bias_rad):.2f} deg would "
-                            f"imitate it through the model's nonlinearity (beside it, t = {b.t_term:.1f}), and the "
-                            f"kinematics cannot rule that bias out ({_bias_text(b)})")
+                _not_named_for(c, f"bias_{x}", (
+                    f"entered, but not named: a {x} vane bias of {np.degrees(b.bias_rad):.2f} deg would imitate it "
+                    f"through the model's nonlinearity (beside it, t = {b.t_term:.1f}), and the kinematics cannot rule "
+                    f"that bias out ({_bias_text(b)})"))
                 break
+        if c.selected:
+            withhold_for_an_unchecked_scale(c, by_key[key].sources, kin, z, columns[key], [columns[n] for n in others],
+                                            slope_of, p, inner)
+
+
+def withhold_for_an_unchecked_scale(c: Candidate, sources: tuple[str, ...], kin: KinematicResult, z: np.ndarray,
+                                    column: np.ndarray, others: list[np.ndarray], slope_of, p: Prepared,
+                                    inner: slice) -> None:
+    """Deselect a term built on a vane's angle (α or β, :data:`rivals.BIAS_SOURCES`) that a
+    scale factor of that vane would imitate where the kinematics could not check one (the
+    angle hardly moves about its mean: ``kin.dropped``). A scale k leaves −k·(∂C/∂x)·x in the
+    mismatch of a model evaluated along the vane, x the angle: collinear with the term's
+    column (|r| >= :data:`rivals.RIVAL_CORRELATION`), the scale it takes plausible
+    (:func:`kinematics.is_plausible`) and the term under the entry t beside it, the two are
+    one. (The outside sweep's F-16 C_m,α change of −0.1 at 550 ft/s, α moving 2.8 times its
+    noise, would take a scale of −1.6 through C_m's slope of −0.035.) An independent script's
+    c182 in a 45° bank (4,600 ft / 186 ft/s, three-axis multisine at 100 Hz, twice the noise,
+    no altitude channel) with its α vane reading 10 % high, α moving 2.7 times its noise, had
+    C_Z,α +1.32 named (t 5.6): beside the scale's column (r 1.000) it stood at t −2.3."""
+    for x in rivals.BIAS_SOURCES:
+        why = kin.dropped.get(f"scale_{x}")
+        if x not in sources or why is None or x not in p.smooth:
+            continue
+        scale = (-slope_of(x)[c.channel] * p.smooth[x])[inner]
+        if np.ptp(scale) <= 0 or np.ptp(column) <= 0:
+            continue
+        r = float(np.corrcoef(scale, column)[0, 1])
+        if abs(r) < rivals.RIVAL_CORRELATION:
+            continue
+        k = rivals.coefficient_beside(z, others, scale)
+        if not is_plausible(f"scale_{x}", k, 0.0):
+            continue
+        try:
+            t_term = rivals.t_pair(z, others, column, scale)[0]
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            t_term = 0.0  # one column: the term cannot be told from the scale
+        if abs(t_term) >= cand.T_IN:
+            continue
+        _not_named_for(c, f"scale_{x}", (
+            f"entered, but not named: a scale factor of the {x} vane of {k:+.3f} would imitate it through the model's "
+            f"slope (columns correlated {r:+.3f}; beside it, t = {t_term:.1f}), and the kinematics could not check one "
+            f"({why})"))
+        return
+
+
+def _not_named_for(c: Candidate, sensor: str, reason: str) -> None:
+    """Deselect ``c`` for the sensor error ``sensor`` that would imitate it, saying why."""
+    c.selected = False
+    c.details["sensor_rival"] = sensor
+    c.reason = reason
 
 
 def note_untested_coupling(cands: list[Candidate], p: Prepared) -> None:
