@@ -181,3 +181,27 @@ def test_the_validation_tells_a_finding_from_its_rival_by_both_predictions():
             kept[name] += joint_prefers(joint)
             assert abs(joint[0 if name == "own" else 1]["k"] - 1.0) < 0.25
     assert kept["own"] >= 14 and kept["rival"] == 0
+
+
+def test_an_alpha_rate_term_on_a_moment_axis_is_built_on_a_z_too():
+    """term_rules.regressor_channels: C_m's α̇ is the kinematic one (q less the normal
+    acceleration over V), so an a_z error is asked of a C_m,α̇ change as the vane's are; the
+    force axes' α̇ is the vane's derivative, and a rate derivative its own gyro's."""
+    from harness.diagnosis.candidates import VANE_ALPHA_RATE_AXES, alpha_rate
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.term_rules import regressor_channels
+
+    def term(effect, channel, parameter):
+        return Candidate(effect, "lon", channel, parameter, 0.0, 0.0, 0.0, 0.0, "", "stepwise", True, "")
+    assert regressor_channels(term("unsteady_alphadot", "Cm", "Cm_alphadot")) == ("alpha", "az")
+    assert "CZ" in VANE_ALPHA_RATE_AXES
+    assert regressor_channels(term("unsteady_alphadot", "CZ", "CZ_alphadot")) == ("alpha",)
+    assert regressor_channels(term("coefficient_error", "Cm", "Cm_qhat")) == ("q",)
+    # the kinematic α̇ moves with a_z: q − (g/V)·a_z·cos… — a_z shifted by 0.1 g moves it
+    n = 200
+    smooth = {c: np.zeros(n) for c in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ax", "az")}
+    smooth["V"] += 400.0
+    smooth["az"] += np.linspace(-1.0, -1.2, n)
+    p = SimpleNamespace(smooth=smooth, deriv={"alpha": np.zeros(n)})
+    moved = alpha_rate(SimpleNamespace(smooth={**smooth, "az": smooth["az"] - 0.1}, deriv=p.deriv))
+    assert np.ptp(alpha_rate(p) - moved) < 1e-9 and abs(np.mean(alpha_rate(p) - moved)) > 1e-3

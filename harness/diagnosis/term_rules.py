@@ -974,6 +974,21 @@ def regressor_channel(c: Candidate) -> str | None:
     return cand.REGRESSOR_SOURCE.get(c.parameter.split("_", 1)[1])
 
 
+def regressor_channels(c: Candidate) -> tuple[str | None, ...]:
+    """The measured channels term ``c``'s regressor is built on (:func:`regressor_channel`),
+    and for an α̇ term on a moment axis also a_z: its α̇ is the kinematic one
+    (:func:`candidates.alpha_rate`), q less the normal acceleration over V, so an a_z lag moves
+    it by (g/V)·τ·ȧ_z, which follows α̇ itself (the q gyro is the axis's own sensor, asked as
+    C_m's). An independent script's J3 Cub (2,400 ft / 118 ft/s, pitch multisine at 100 Hz,
+    half the noise) with a_z 40 ms late had C_m,α̇ +1.16 named (t 10): the kinematics suspected
+    the skew (46 ms, t 7.0) but could not tell it from an α-vane scale, and only the vane's
+    errors had been asked."""
+    own = regressor_channel(c)
+    if c.effect == "unsteady_alphadot" and c.channel not in cand.VANE_ALPHA_RATE_AXES:
+        return own, "az"
+    return (own,)
+
+
 def euler_lead(kin: KinematicResult, name: str, euler_lag: EulerLag | None) -> bool:
     """Whether gyro-skew suspicion ``name`` (the unit's or one gyro's) reads the gyros *leading*
     by no more than a simulation's rectangular-Euler step allows (:func:`euler_lag_estimate`:
@@ -1096,10 +1111,9 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
             _withhold_skewed_delay(c, kin)
         if not (c.selected and c.effect in ("coefficient_error", "unsteady_alphadot", "nonlinear_alpha")):
             continue
-        channel = regressor_channel(c)
-        found = next((r for r in rivals_of(channel) if explains(c, *r)), None)
+        found = next(((r, ch) for ch in regressor_channels(c) for r in rivals_of(ch) if explains(c, *r)), None)
         if found is not None:
-            rival, t = found
+            (rival, t), channel = found
             c.selected = False
             c.details["sensor_rival"] = rival
             c.details["suspicion"] = _suspicion(rival, t, contest_at)
