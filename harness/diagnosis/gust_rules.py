@@ -4,6 +4,7 @@ terms gusts or vane wander keep from being named."""
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import linregress
 
 from harness.diagnosis.along import ModelAlong, model_along, slope_function
 from harness.diagnosis.evidence import Candidate
@@ -36,11 +37,10 @@ def airspeed_bias_in_the_gust(p: Prepared, gust) -> tuple[float, float]:
     raw["V"] = raw["V"] + 1.0
     column = gust_estimate(kinematic_residuals(raw, p), p, 1.0).w_fps - gust.w_fps
     inner = interior_slice(p.n, p.dt)
-    y, A = gust.w_fps[inner], np.column_stack([column[inner], np.ones(inner.stop - inner.start)])
-    theta, *_ = np.linalg.lstsq(A, y, rcond=None)
-    left = float(np.sum((y - A @ theta) ** 2))
-    total = float(np.sum((y - np.mean(y)) ** 2))
-    return float(theta[0]), (1.0 - left / total) if total > 0 else 0.0
+    if np.ptp(column[inner]) <= 0 or np.ptp(gust.w_fps[inner]) <= 0:
+        return 0.0, 0.0
+    fit = linregress(column[inner], gust.w_fps[inner])
+    return float(fit.slope), float(fit.rvalue) ** 2
 
 
 def gusts_of_an_airspeed_bias(p: Prepared, gust, V0: float) -> str:
