@@ -9,6 +9,7 @@ from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refut
                                                    withhold_through_the_inertial_angles)
 from harness.diagnosis.airspeed_rules import withhold_on_the_airspeed
 from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
+from harness.diagnosis.delay_rules import name_the_delay_the_terms_imitate
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
 from harness.diagnosis.gust_biases import gusts_without_biases, note_gusts_of_biases
@@ -35,13 +36,15 @@ from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offse
 from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, inertial_alpha_sensors,
                                           note_surface_scale, note_untested_coupling,
                                           withhold_off_the_integration_drift,
-                                          withhold_alpha_power_off_the_inertial_alpha, withhold_ambiguous,
+                                          withhold_alpha_power_off_the_inertial_alpha,
+                                          withhold_alpha_slope_off_the_inertial_alpha, withhold_ambiguous,
                                           withhold_even_term_off_the_quiet_flight,
                                           withhold_explained_by_cg, withhold_explained_by_force_arm,
                                           withhold_explained_by_lift,
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane,
-                                          withhold_resting_on_an_uncertain_correction, withhold_rivals)
+                                          withhold_resting_on_an_uncertain_correction, withhold_rivals,
+                                          withhold_the_shift_remainder)
 from harness.diagnosis.wander_rules import withhold_within_the_unseen_wander
 from models.aircraft import Aircraft, has_propeller
 from models.replay import InitialCondition
@@ -123,6 +126,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     propeller = has_propeller(aircraft.model)
     step = stepwise_fits(p, propeller, aero, measured, mismatch, delays, vane)
     cands += aero_candidates(step.selections, delays, p.dt, step.shares)
+    name_the_delay_the_terms_imitate(cands, step, delays, p, mismatch)
     if not propeller:
         withhold_thrust_drift(cands, p, aero.trim)
     if step.pinned is not None:
@@ -132,11 +136,13 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_beside_the_accelerometer(cands, step.selections, p, as_evaluated, noise)
     # the rules that keep a term from being named when something else would imitate it
     withhold_explained_by_cg(cands, step.selections, mismatch, p)
+    withhold_the_shift_remainder(cands, step, mismatch, p, measured)
     withhold_explained_by_lift(cands, step.selections, mismatch, p)
     withhold_explained_by_force_arm(cands, step.selections, mismatch, p, aero.trim)
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     withhold_lateral_drift_a_slow_sideslip_makes(cands, step, p, mismatch, slope_of)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
+    withhold_alpha_slope_off_the_inertial_alpha(cands, step, p, mismatch)
     withhold_even_term_off_the_quiet_flight(cands, step, p, mismatch)
     withhold_force_drift_off_the_vane_wander(cands, step, p, mismatch, slope_of, wander_gust, V0)
     withhold_off_the_integration_drift(cands, step, p, mismatch)

@@ -67,6 +67,48 @@ def withhold_explained_by_cg(cands: list[Candidate], selections: dict, mismatch:
                             f"({cg.estimate:.3g} ft): with its share of the {axis} mismatch removed, t = {t:.1f}")
 
 
+def withhold_the_shift_remainder(cands: list[Candidate], step: StepwiseFits, mismatch: dict[str, np.ndarray],
+                                 p: Prepared, measured: dict[str, np.ndarray]) -> None:
+    """A moment-reference shift named at the size C_m's mistrim says
+    (:func:`stepwise_axes.pinned_shift`) leaves, where that mistrim fell short of the shift
+    (the model's own mistrim, the thrust's moment, share the constant), the rest of the shift
+    in C_m's excursions, where a term C_Z's column imitates (C_Z follows α) takes it. A C_m
+    term the refit entered beside the pinned shift is kept only if it stays significant
+    (|t| >= the entry t) with the shift C_m's excursions read without it (the C_Z column
+    fitted beside the other entered terms, a constant free) taken out; a same-signed larger
+    shift would otherwise leave it there. (A probe's Cessna 172 at 4,800 ft and 180 ft/s,
+    pitch doublets, with a 0.5 ft shift: the mistrim said 0.35 ft, the excursions 0.54 ft, and
+    C_m,α −0.17 was named beside the 0.35 ft, what 0.15 ft more makes through C_Z,α; beside
+    0.54 ft, t −0.9.)"""
+    shift = next((c for c in cands if c.selected and c.parameter == "dx_moment_reference" and c.channel == "Cm"
+                  and c.test.startswith("the mistrim")), None)
+    if shift is None or step.pinned is None or "Cm" not in step.selections:
+        return
+    inner = interior(p)
+    cz, cbar = measured["CZ"][inner], p.meta["geometry"]["cbar_ft"]
+    z = mismatch["Cm"][inner] - shift.estimate / cbar * cz
+    sel, by_key = step.selections["Cm"]
+    chosen = [k for k in sel.names if k in by_key and k != "cg"]
+    nuisance = [c[inner] for c in step.nuisances.get("Cm", {}).values() if np.ptp(c[inner]) > 0]
+    for c in cands:
+        key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
+        if not c.selected or c.channel != "Cm" or key is None:
+            continue
+        others = [by_key[k].column[inner] for k in chosen if k != key] + nuisance
+        more = _refit_term(z, others, cz)
+        if more is None or np.sign(more[0]) != np.sign(shift.estimate):
+            continue
+        fit = _refit_term(z - more[0] * cz, others, by_key[key].column[inner])
+        if fit is not None and abs(fit[1]) < cand.T_IN:
+            dx = shift.estimate + more[0] * cbar
+            c.selected = False
+            c.details["shift_remainder"] = {"mistrim_dx_ft": shift.estimate, "excursion_dx_ft": dx, "t": fit[1]}
+            c.reason = (f"entered beside the moment-reference shift C_m's mistrim sized ({shift.estimate:.3g} ft), "
+                        f"but C_m's excursions without this term read a {dx:.3g} ft shift, and beside that t = "
+                        f"{fit[1]:.1f}: the mistrim may fall short of the shift, and the record cannot tell the rest "
+                        "from this term")
+
+
 def lift_change_on_cx(delta_cz: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     """The body-axis C_X that a change of lift carries when its C_Z share is ``delta_cz``:
     C_X = −C_D cos α + C_L sin α and C_Z = −C_D sin α − C_L cos α, so ΔC_L alone gives
@@ -328,6 +370,37 @@ def withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: St
             c.selected = False
             c.reason = (f"entered, but beside the linear α term, both built on the inertial α (free of the vane's "
                         f"wander, which favours a power of α), t = {fit[1]:.1f}")
+
+
+def withhold_alpha_slope_off_the_inertial_alpha(cands: list[Candidate], step: StepwiseFits, p: Prepared,
+                                                mismatch: dict[str, np.ndarray]) -> None:
+    """A named change of a longitudinal α derivative must stay significant when its column is
+    built on the inertial α (:func:`kinematics.inertial_angles`) rather than the vane's.
+
+    The model evaluated along the vane passes the vane's error e through its slope, so the
+    mismatch carries −C_α·e, and the vane's α, which carries e too, fits it: errors in
+    variables, a change of −C_α·var(e)/var(α) where the vane's noise is a fair share of the
+    α excursions (C_m has the vane-noise column for it, :func:`stepwise_axes.vane_noise_columns`;
+    C_X and C_Z do not). The inertial α does not carry e. (A probe's MD-11 null at 22,000 ft
+    and 712 ft/s, a pitch sweep at 50 Hz with twice the usual noise, was named C_Z,α −0.27 at
+    t 16; at the usual noise, or without noise, nothing.)"""
+    chosen = [c for c in cands if c.selected and c.effect == "coefficient_error" and c.channel in step.selections
+              and c.parameter == f"{c.channel}_alpha"]
+    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
+        return
+    inner = interior(p)
+    da = inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"]
+    for c in chosen:
+        sel, by_key = step.selections[c.channel]
+        if "alpha" not in sel.names or "alpha" not in by_key:
+            continue
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k != "alpha"]
+        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
+        fit = _refit_term(mismatch[c.channel][inner], others, da[inner])
+        if fit is not None and abs(fit[1]) < cand.T_IN:
+            c.selected = False
+            c.reason = (f"entered, but built on the inertial α (free of the vane's noise, which the model along the "
+                        f"vane passes into the mismatch through its slope) t = {fit[1]:.1f}")
 
 
 def withhold_even_term_off_the_quiet_flight(cands: list[Candidate], step: StepwiseFits, p: Prepared,
