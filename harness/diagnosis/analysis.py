@@ -142,7 +142,6 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_lateral_drift_off_the_vane(cands, step, p, aircraft, ic)
     withhold_lateral_drift_a_slow_sideslip_makes(cands, step, p, mismatch, slope_of)
     withhold_alpha_power_off_the_inertial_alpha(cands, step, p, mismatch)
-    withhold_alpha_slope_off_the_inertial_alpha(cands, step, p, mismatch)
     withhold_even_term_off_the_quiet_flight(cands, step, p, mismatch)
     withhold_force_drift_off_the_vane_wander(cands, step, p, mismatch, slope_of, wander_gust, V0)
     withhold_off_the_integration_drift(cands, step, p, mismatch)
@@ -169,6 +168,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         if plausible and not gusty:
             kinematic_rivals(cands, kin, p, signature, contested)
         withhold_vane_scale(cands, kin, step, signature, inertial_beta(p))
+        withhold_alpha_slope_off_the_inertial_alpha(cands, step, p, mismatch)
         if plausible and not gusty:
             name_corroborated(cands, kin, p, signature, set(sensor_values), V0)
             for vane in VANE_MEANS_AXES:

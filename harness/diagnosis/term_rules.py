@@ -383,7 +383,10 @@ def withhold_alpha_slope_off_the_inertial_alpha(cands: list[Candidate], step: St
     α excursions (C_m has the vane-noise column for it, :func:`stepwise_axes.vane_noise_columns`;
     C_X and C_Z do not). The inertial α does not carry e. (A probe's MD-11 null at 22,000 ft
     and 712 ft/s, a pitch sweep at 50 Hz with twice the usual noise, was named C_Z,α −0.27 at
-    t 16; at the usual noise, or without noise, nothing.)"""
+    t 16; at the usual noise, or without noise, nothing.) Asked after the vane-scale test
+    (:func:`sensor_naming.withhold_vane_scale`), since a vane's scale or bias is an error the
+    inertial α does not carry either, and only in smooth air, where the vane's α is the
+    inertial one and its own error."""
     chosen = [c for c in cands if c.selected and c.effect == "coefficient_error" and c.channel in step.selections
               and c.parameter == f"{c.channel}_alpha"]
     if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
