@@ -167,3 +167,32 @@ def test_terms_a_late_elevator_imitates_give_way_to_its_delay():
     cands, step, delays, p, mismatch = _late_elevator_case(lambda column, alpha: 0.3 * alpha + 0.01 * column)
     name_the_delay_the_terms_imitate(cands, step, delays, p, mismatch)
     assert not cands[0].selected and all(c.selected for c in cands[1:])
+
+
+def test_an_accelerometer_skew_not_ruled_out_is_asked_of_its_forces_rate_terms():
+    """term_rules.withhold_ambiguous: a probe's F-4N (15,500 ft / 665 ft/s, three-axis
+    multisine) with a_z 40 ms late was named C_Z,q̂ +12.2 (t 7.8), the skew's τ·Ċ_Z, which
+    follows α̇; the kinematics read the skew at 24.0 ± 15.6 ms (t 1.5), under the suspicion's
+    t. C_Z is measured with a_z, so its skew is asked of C_Z's rate terms whatever its t; a
+    C_Z,α change (its level, not its rate) is not asked, nor a moment's rate term."""
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.term_rules import IMITATION_SHARE, withhold_ambiguous
+    kin = SimpleNamespace(parameters={"skew_az": SimpleNamespace(channel="az")},
+                          selection=SimpleNamespace(params={}, names=(), std_errors={}, terms=[
+                              SimpleNamespace(name="skew_az", estimate=0.02396, t=1.53, std_error=0.0156)]))
+    asked = []
+
+    def imitated(c, name, at=None):
+        asked.append((c.parameter, name))
+        return IMITATION_SHARE * abs(c.details["change"])
+
+    def term(axis, name, change):
+        return Candidate("coefficient_error", "lon", axis, f"{axis}_{name}", change, 1.0, 7.8, 0.2, "per rad",
+                         f"stepwise on the {axis} mismatch", selected=True, reason="entered",
+                         details={"change": change})
+
+    rate, level, moment = term("CZ", "qhat", 12.2), term("CZ", "alpha", -0.5), term("Cm", "qhat", -4.0)
+    withhold_ambiguous([rate, level, moment], kin, imitated)
+    assert not rate.selected and "skew_az: 24.0 ± 15.6 ms, t = 1.5" in rate.reason
+    assert level.selected and moment.selected
+    assert asked == [("CZ_qhat", "skew_az")]

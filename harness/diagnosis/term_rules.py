@@ -1114,7 +1114,10 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
     script's twenty c172x pitch nulls at 100 Hz named 9 false findings at the sixteenth
     session's start, 3 with suspected skews alone, 1 so. Asked on every axis, not only where
     the column is, it withheld six true F-16 and DHC-6 findings of the outside sweep (C_m,α̇
-    −3, C_m,q̂ −6, C_n,r̂ −0.3, C_l,p̂ −0.1), whose skews the kinematics bound loosely.
+    −3, C_m,q̂ −6, C_n,r̂ −0.3, C_l,p̂ −0.1), whose skews the kinematics bound loosely. A force
+    axis's own accelerometer skew is asked so too, whatever its t, of that axis's rate terms
+    (a skew τ adds τ·Ċ, which follows α̇ or the rate): a probe's F-4N with a_z 40 ms late was
+    named C_Z,q̂ +12.2 (t 7.8), the skew read at 24 ± 16 ms (t 1.5).
 
     ``euler_lag`` (:func:`euler_lag_estimate`), unless the kinematics rule it out, is asked of
     every rate-shaped moment term (C_m,α̇ and the rate derivatives of C_l, C_m, C_n) the same
@@ -1203,9 +1206,10 @@ def withhold_ambiguous(cands: list[Candidate], kin: KinematicResult, imitated=No
         # where the α vane's error column is in the fit, the gyros' skew reaches every term
         # through it, and a skew need not be suspected: one not ruled out is asked too
         through_column = c.channel in (column_sensors or {})
-        if through_column:
-            rivals += [(r, sensor) for sensor in sensors for r in unruled_skews(sensor)
-                       if (r[0], sensor) not in [(x[0], y) for x, y in rivals]]
+        # an accelerometer's skew moves its own force's rate terms: asked whatever its t too
+        unruled = sensors if through_column else sensors[:1] if lag_shaped and c.channel in cand.FORCE_AXES else ()
+        rivals += [(r, sensor) for sensor in unruled for r in unruled_skews(sensor)
+                   if (r[0], sensor) not in [(x[0], y) for x, y in rivals]]
         if not (c.selected and rivals and c.test.startswith("stepwise")):
             continue
         found = next(((r, sensor) for r, sensor in rivals
