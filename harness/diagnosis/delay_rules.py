@@ -47,7 +47,7 @@ def name_the_delay_the_terms_imitate(cands: list[Candidate], step: StepwiseFits,
             entered = [c for c in cands if c.selected and c.channel == axis and c.test.startswith("stepwise")]
             if sel is None or not entered:
                 continue
-            nuisance = {k: v for k, v in step.nuisances.get(axis, {}).items()}
+            nuisance = dict(step.nuisances.get(axis, {}))
             tau, t = delay_column_t(mismatch[axis][inner], column[inner],
                                     [v[inner] for v in nuisance.values() if np.ptp(v[inner]) > 0])
             again = cand.axis_selection(p, axis, mismatch[axis], list(by_key.values()),

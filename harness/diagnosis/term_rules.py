@@ -79,7 +79,7 @@ def withhold_the_shift_remainder(cands: list[Candidate], step: StepwiseFits, mis
     shift would otherwise leave it there. (A probe's Cessna 172 at 4,800 ft and 180 ft/s,
     pitch doublets, with a 0.5 ft shift: the mistrim said 0.35 ft, the excursions 0.54 ft, and
     C_m,α −0.17 was named beside the 0.35 ft, what 0.15 ft more makes through C_Z,α; beside
-    0.54 ft, t −0.9.)"""
+    0.54 ft, t 0.7.)"""
     shift = next((c for c in cands if c.selected and c.parameter == "dx_moment_reference" and c.channel == "Cm"
                   and c.test.startswith("the mistrim")), None)
     if shift is None or step.pinned is None or "Cm" not in step.selections:
@@ -403,7 +403,7 @@ def withhold_alpha_slope_off_the_inertial_alpha(cands: list[Candidate], step: St
         if fit is not None and abs(fit[1]) < cand.T_IN:
             c.selected = False
             c.reason = (f"entered, but built on the inertial α (free of the vane's noise, which the model along the "
-                        f"vane passes into the mismatch through its slope) t = {fit[1]:.1f}")
+                        f"vane passes into the mismatch through its slope), t = {fit[1]:.1f}")
 
 
 def withhold_even_term_off_the_quiet_flight(cands: list[Candidate], step: StepwiseFits, p: Prepared,
