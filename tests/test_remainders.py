@@ -196,3 +196,18 @@ def test_an_accelerometer_skew_not_ruled_out_is_asked_of_its_forces_rate_terms()
     assert not rate.selected and "skew_az: 24.0 ± 15.6 ms, t = 1.5" in rate.reason
     assert level.selected and moment.selected
     assert asked == [("CZ_qhat", "skew_az")]
+
+
+def test_a_delay_column_dependent_on_the_nuisances_replaces_nothing():
+    """delay_rules.delay_column_t: a delay column that is one of the nuisance columns (or
+    constant) gives zeros rather than the singular fit's error, so no term is replaced (a
+    recording diagnosed against another aircraft's model reached the rule with such a
+    column before its refusal)."""
+    from harness.diagnosis.delay_rules import delay_column_t
+    rng = np.random.default_rng(1)
+    z = rng.standard_normal(200)
+    column = np.sin(np.linspace(0.0, 6.0, 200))
+    assert delay_column_t(z, column, [2.0 * column]) == (0.0, 0.0)
+    assert delay_column_t(z, np.ones(200), []) == (0.0, 0.0)
+    tau, t = delay_column_t(0.05 * column + 1e-3 * z, column, [])
+    assert abs(tau - 0.05) < 1e-3 and t > 5.0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import interior
 from harness.diagnosis.evidence import Candidate
@@ -15,8 +16,12 @@ from harness.diagnosis.stepwise_axes import StepwiseFits, practical_delay
 def delay_column_t(z: np.ndarray, column: np.ndarray, nuisance: list[np.ndarray]) -> tuple[float, float]:
     """The delay column's coefficient (the delay τ, s: the column is the model's change per
     second of delay, :func:`candidates.delay_scan`) and its colored t, fitted on ``z``
-    beside the axis's nuisance columns and a constant (Eq. 5, Eq. 40's standard error)."""
-    theta, se, _ = colored_fit(z, [column] + nuisance, ["delay"] + [f"n{i}" for i in range(len(nuisance))])
+    beside the axis's nuisance columns and a constant (Eq. 5, Eq. 40's standard error); zeros
+    when the columns are dependent."""
+    try:
+        theta, se, _ = colored_fit(z, [column] + nuisance, ["delay"] + [f"n{i}" for i in range(len(nuisance))])
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return 0.0, 0.0
     return float(theta[0]), (float(theta[0] / se[0]) if se[0] > 0 else 0.0)
 
 
@@ -50,9 +55,8 @@ def name_the_delay_the_terms_imitate(cands: list[Candidate], step: StepwiseFits,
             nuisance = dict(step.nuisances.get(axis, {}))
             tau, t = delay_column_t(mismatch[axis][inner], column[inner],
                                     [v[inner] for v in nuisance.values() if np.ptp(v[inner]) > 0])
-            again = cand.axis_selection(p, axis, mismatch[axis], list(by_key.values()),
-                                        forced=nuisance | {f"delay_{surface}": column})
-            if tau <= 0.0 or t < cand.T_IN or again.names:
+            if tau <= 0.0 or t < cand.T_IN or _enters_beside(p, axis, mismatch[axis], by_key, nuisance,
+                                                             {f"delay_{surface}": column}):
                 replaced = []
                 break
             replaced += entered
@@ -68,3 +72,13 @@ def name_the_delay_the_terms_imitate(cands: list[Candidate], step: StepwiseFits,
         delay.details["replaced"] = [c.parameter for c in replaced]
         delay.reason = (f"the stepwise entered {names} instead; its delay column alone stands at t = {t_best:.1f}, "
                         "and beside it no term enters")
+
+
+def _enters_beside(p: Prepared, axis: str, z: np.ndarray, by_key: dict, nuisance: dict, delay: dict) -> bool:
+    """Whether ``axis``'s stepwise enters any of its terms with the delay column ``delay``
+    forced into the fit beside the nuisances (True, so nothing is replaced, when the forced
+    columns are dependent)."""
+    try:
+        return bool(cand.axis_selection(p, axis, z, list(by_key.values()), forced=nuisance | delay).names)
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return True
