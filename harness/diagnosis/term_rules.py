@@ -336,6 +336,28 @@ def withhold_lateral_drift_off_the_vane(cands: list[Candidate], step: StepwiseFi
                         f"the airspeed's; along the β vane's own record t = {t:.1f}")
 
 
+def _beside_the_inertial_alpha(chosen: list[Candidate], step: StepwiseFits, p: Prepared):
+    """For each named term of ``chosen``: ``(term, key, others, da)``, ``others`` the interior
+    columns of its axis's other entered terms but the linear α and its nuisances, ``da`` the
+    interior inertial α (:func:`kinematics.inertial_angles`, from each channel's own
+    smoothing) less the vane's α at the start. Empty without the channels it is integrated
+    from."""
+    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
+        return []
+    inner = interior(p)
+    da = (inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"])[inner]
+    out = []
+    for c in chosen:
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
+        if key is None:
+            continue
+        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k not in (key, "alpha")]
+        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
+        out.append((c, key, others, da))
+    return out
+
+
 def withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: StepwiseFits, p: Prepared,
                                                 mismatch: dict[str, np.ndarray]) -> None:
     """A named α² or α³ term must stay significant beside the linear α term when both are
@@ -351,22 +373,11 @@ def withhold_alpha_power_off_the_inertial_alpha(cands: list[Candidate], step: St
     question asked of it is only which shape, with the axis's other entered terms and
     nuisances beside both columns."""
     chosen = [c for c in cands if c.selected and c.effect == "nonlinear_alpha" and c.channel in step.selections]
-    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
-        return
     inner = interior(p)
-    da = inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"]
-    for c in chosen:
-        sel, by_key = step.selections[c.channel]
-        key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
-        if key is None:
-            continue
+    for c, key, others, da in _beside_the_inertial_alpha(chosen, step, p):
         power = 2 if key == "alpha2" else 3
-        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k not in (key, "alpha")]
-        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
-        fit = _refit_term(mismatch[c.channel][inner], others + [da[inner]], da[inner] ** power)
-        if fit is None:
-            continue
-        if abs(fit[1]) < cand.T_IN:
+        fit = _refit_term(mismatch[c.channel][inner], others + [da], da ** power)
+        if fit is not None and abs(fit[1]) < cand.T_IN:
             c.selected = False
             c.reason = (f"entered, but beside the linear α term, both built on the inertial α (free of the vane's "
                         f"wander, which favours a power of α), t = {fit[1]:.1f}")
@@ -389,17 +400,9 @@ def withhold_alpha_slope_off_the_inertial_alpha(cands: list[Candidate], step: St
     inertial one and its own error."""
     chosen = [c for c in cands if c.selected and c.effect == "coefficient_error" and c.channel in step.selections
               and c.parameter == f"{c.channel}_alpha"]
-    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
-        return
     inner = interior(p)
-    da = inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"]
-    for c in chosen:
-        sel, by_key = step.selections[c.channel]
-        if "alpha" not in sel.names or "alpha" not in by_key:
-            continue
-        others = [by_key[k].column[inner] for k in sel.names if k in by_key and k != "alpha"]
-        others += [v[inner] for v in step.nuisances.get(c.channel, {}).values() if np.ptp(v[inner]) > 0]
-        fit = _refit_term(mismatch[c.channel][inner], others, da[inner])
+    for c, _, others, da in _beside_the_inertial_alpha(chosen, step, p):
+        fit = _refit_term(mismatch[c.channel][inner], others, da)
         if fit is not None and abs(fit[1]) < cand.T_IN:
             c.selected = False
             c.reason = (f"entered, but built on the inertial α (free of the vane's noise, which the model along the "
