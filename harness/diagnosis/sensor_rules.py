@@ -277,8 +277,9 @@ def _withhold_bias_beside_a_scale(bias: Candidate, scale: Candidate, k_off: floa
     bias.details["scale_rival"] = {"parameter": scale.parameter, "offset_k": k_off, "offset_k_std": se_off,
                                    "excursion_k": k_exc, "excursion_k_std": se_exc}
     shape = "" if "shape" not in scale.details else " with the mismatch's shape"
+    shown = f"named, t = {scale.t:.1f}" if scale.selected else f"the kinematics t = {scale.t:.1f}"
     bias.reason = (f"entered, but not named: {scale.parameter} would make an offset too, and the excursions show one "
-                   f"(the kinematics t = {scale.t:.1f}; k = {k_exc:.3f} ± {se_exc:.3f}{shape}) that does not agree "
+                   f"({shown}; k = {k_exc:.3f} ± {se_exc:.3f}{shape}) that does not agree "
                    f"with the offset read as a scale (k = {k_off:.3f} ± {se_off:.3f}): bias, scale or both")
 
 

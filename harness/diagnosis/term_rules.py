@@ -396,8 +396,9 @@ def withhold_alpha_slope_off_the_inertial_alpha(cands: list[Candidate], step: St
     and 712 ft/s, a pitch sweep at 50 Hz with twice the usual noise, was named C_Z,α −0.27 at
     t 16; at the usual noise, or without noise, nothing.) Asked after the vane-scale test
     (:func:`sensor_naming.withhold_vane_scale`), since a vane's scale or bias is an error the
-    inertial α does not carry either, and only in smooth air, where the vane's α is the
-    inertial one and its own error."""
+    inertial α does not carry either, and not in turbulence, where the vane's α is the air's
+    and the inertial α lacks the gusts (in light gusts it lacks their share too: a true change
+    may then be withheld, the safe side)."""
     chosen = [c for c in cands if c.selected and c.effect == "coefficient_error" and c.channel in step.selections
               and c.parameter == f"{c.channel}_alpha"]
     inner = interior(p)
