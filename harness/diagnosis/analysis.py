@@ -24,8 +24,8 @@ from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, 
                                              name_vane_bias_from_means, signature_ratios,
                                              withhold_delays_imitated_by_named, withhold_imitated_by_named,
                                              withhold_vane_scale)
-from harness.diagnosis.sensor_rules import (applied_sensor_values, contested_parameters, kinematic_candidates,
-                                            kinematics_plausible, name_accelerometer_once,
+from harness.diagnosis.sensor_rules import (applied_sensor_values, biases_of_contested, contested_parameters,
+                                            kinematic_candidates, kinematics_plausible, name_accelerometer_once,
                                             plausible_kinematic_check, scale_read_as_bias,
                                             steady_vane, withhold_biases_an_airspeed_bias_makes,
                                             withhold_offset_of_a_scaled_vane, withhold_scale_a_bias_would_make)
@@ -97,8 +97,9 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         turbulent, gusty, near = False, "", light_gusts(gust, p, V0, LIGHT_TURBULENCE_FACTOR)
     plausible = kinematics_plausible(kin, V0, p)
     contested = contested_parameters(kin, p)
+    unapplied = set(contested) | biases_of_contested(kin, contested)
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
-                     if n not in contested and steady_vane(n, p) is None}
+                     if n not in unapplied and steady_vane(n, p) is None}
     # 2. the model along the measured states
     recorded, (p, along, mismatch, refuted) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along[:5]
@@ -125,7 +126,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     vane = vane_noise_columns(p, along, slope_of, V0, mismatch, wander_gust)
     propeller = has_propeller(aircraft.model)
     step = stepwise_fits(p, propeller, aero, measured, mismatch, delays, vane)
-    cands += aero_candidates(step.selections, delays, p.dt, step.shares)
+    cands += aero_candidates(step.selections, delays, p.dt, step.shares, step.ar_t)
     name_the_delay_the_terms_imitate(cands, step, delays, p, mismatch)
     if not propeller:
         withhold_thrust_drift(cands, p, aero.trim)

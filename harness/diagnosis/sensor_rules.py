@@ -567,6 +567,18 @@ def kinematic_rival(kin: KinematicResult, name: str, min_correlation: float | No
 KINEMATIC_RIVAL_CORRELATION = 0.7
 
 
+def _still_preferred(found: tuple) -> bool:
+    """Beside its rival (:func:`kinematic_rival`'s ``found``) the data still prefer the selected
+    term: it keeps |t| >= :data:`AMBIGUOUS_T` while the rival falls below it, and the rival alone
+    would not have entered (|t| < the kinematic entry t in the term's place). Where it would, the
+    colored t beside each other is no verdict: an independent script's T-37 (5,800 ft / 343 ft/s,
+    pitch frequency sweep at 100 Hz) with a_z 40 ms late had an α scale of −0.098 named (t 10.1;
+    beside the a_z skew t 5.0, the skew 0.3) while the skew alone stood at 36 ms, t 7.5; without
+    the noise on V, h and θ that took the h equation's weight the skew was named (39.7 ms)."""
+    _, _, t_own, t_rival, alone = found
+    return t_own >= AMBIGUOUS_T and t_rival < AMBIGUOUS_T and not (alone is not None and alone[1] >= KIN_T_IN)
+
+
 def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dict[str, Contest]:
     """The selected kinematic terms the kinematics cannot tell from a rival
     (:func:`kinematic_rival`: |t| beside it below their entry t, unless it stays at least
@@ -577,7 +589,7 @@ def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dic
     out = {}
     for n in kin.selection.names:
         found = kinematic_rival(kin, n)
-        if found is not None and found[2] < KIN_T_IN and not (found[2] >= AMBIGUOUS_T and found[3] < AMBIGUOUS_T):
+        if found is not None and found[2] < KIN_T_IN and not _still_preferred(found):
             out[n] = Contest(*found[:3], rival_estimate=found[4])
             continue
         exact = skew_rival(kin, p, n) if p is not None else None
@@ -586,6 +598,22 @@ def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dic
                              f"the exact shift of {exact.rival} at {1000 * exact.tau:.1f} ms leaves less kinematic "
                              f"residual ({exact.rss_skew:.0f} against {exact.rss_term:.0f}) than its first-order "
                              "column lets the linearised fit see")
+    return out
+
+
+def biases_of_contested(kin: KinematicResult, contested: dict[str, Contest]) -> set[str]:
+    """The nuisance biases not applied beside a contested term: those that fall below
+    :data:`APPLY_T` with its rival fitted in its place (an α scale factor shifts α's mean by
+    k·ᾱ, which the α bias then takes). Applied while the term is not, such a bias moves the
+    model along a part of an error the data may not have: the T-37 of
+    :func:`_still_preferred`, its α scale contested, had the α bias of +0.14° that the scale
+    left (t 7.5) applied, and the curvature of its drag table read the shift as a C_X,α change
+    of +0.028 (t 11.3)."""
+    out = set()
+    for name, contest in contested.items():
+        beside = kinematic_t_beside(kin, contest.rival, name) if contest.rival in (kin.columns or {}) else None
+        if beside is not None:
+            out |= {b for b in kin.forced if beside.get(b, np.inf) < APPLY_T}
     return out
 
 

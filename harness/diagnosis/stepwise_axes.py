@@ -3,7 +3,7 @@ delay scans, the nuisance columns (thrust, vane noise), the moment-reference mea
 and the candidates the selections give, with their practical sizes."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
@@ -71,6 +71,7 @@ class StepwiseFits:
     not_offered: dict       # axis -> terms not offered, with the reason
     shares: dict            # (axis, key) -> share of the coefficient's excursion
     pinned: CgMeanTest | None = None  # a moment-reference shift sized by C_m's mistrim
+    ar_t: dict = field(default_factory=dict)  # (axis, key) -> t with the AR autocorrelation (candidates.AR_ENTRY_T)
 
 
 # The α vane's noise column enters C_m's fit where it is a material part of the mismatch:
@@ -130,7 +131,7 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
     columns), with the thrust nuisance where thrust was not recorded and the α vane's noise
     column (:func:`vane_noise_columns`) where the model follows the vane; drift terms that
     thrust or a propeller would imitate are not offered."""
-    selections, nuisances, not_offered, shares, pools = {}, {}, {}, {}, {}
+    selections, nuisances, not_offered, shares, pools, ar_t = {}, {}, {}, {}, {}, {}
     for axis in COEFFICIENTS:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
@@ -147,7 +148,7 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
             terms = [t for t in terms if t.key != "dV"]
         extra = {f"delay_{s}": scan.columns[axis] for s, scan in delays.items() if axis in scan.columns}
         pools[axis] = (terms, extra)
-        selections[axis] = _select(p, axis, mismatch, terms, extra, nuisance, measured, shares)
+        selections[axis] = _select(p, axis, mismatch, terms, extra, nuisance, measured, shares, ar_t)
         nuisances[axis] = nuisance
     pinned = None
     for axis in ("Cm", "Cn"):  # C_m first: the test of either axis's shift is C_m's constant
@@ -163,11 +164,11 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
             terms, extra = pools[a]
             terms = [t for t in terms if t.effect != "cg_offset"]
             shares = {k: v for k, v in shares.items() if k[0] != a}
-            selections[a] = _select(p, a, mismatch, terms, extra, nuisances[a], measured, shares)
+            selections[a] = _select(p, a, mismatch, terms, extra, nuisances[a], measured, shares, ar_t)
             pools[a] = (terms, extra)
         not_offered[axis].append({"effect": "cg_offset", "parameter": "dx_moment_reference", "sources": ["alpha"],
                                   "reason": test.reason})
-    return StepwiseFits(selections, nuisances, not_offered, shares, pinned)
+    return StepwiseFits(selections, nuisances, not_offered, shares, pinned, ar_t)
 
 
 def pinned_shift(test: CgMeanTest, p: Prepared | None = None, trim: TrimPoint | None = None) -> Candidate:
@@ -240,15 +241,20 @@ def _without_shift(p: Prepared, mismatch: dict[str, np.ndarray], measured: dict[
 
 
 def _select(p: Prepared, axis: str, mismatch: dict[str, np.ndarray], terms: list, extra: dict,
-            nuisance: dict, measured: dict[str, np.ndarray], shares: dict) -> tuple:
+            nuisance: dict, measured: dict[str, np.ndarray], shares: dict, ar_t: dict) -> tuple:
     """One axis's stepwise (:func:`candidates.axis_selection`), each term's share of the
-    coefficient's excursion put in ``shares``; returns ``(selection, {key: Term})``."""
+    coefficient's excursion put in ``shares`` and each selected term's t with the AR residual
+    autocorrelation in ``ar_t`` (:func:`candidates.autoregressive_t`); returns
+    ``(selection, {key: Term})``."""
     inner = interior(p)
     sel = cand.axis_selection(p, axis, mismatch[axis], terms, extra, forced=nuisance)
     by_key = {t.key: t for t in terms}
+    columns = {t.name: by_key[t.name].column if t.name in by_key else extra[t.name] for t in sel.terms}
     for t in sel.terms:
-        column = by_key[t.name].column if t.name in by_key else extra[t.name]
-        shares[(axis, t.name)] = cand.contribution_share(column[inner], t.estimate, measured[axis][inner])
+        shares[(axis, t.name)] = cand.contribution_share(columns[t.name][inner], t.estimate, measured[axis][inner])
+    for k in [k for k in ar_t if k[0] == axis]:
+        del ar_t[k]
+    ar_t.update({(axis, n): t for n, t in cand.autoregressive_t(mismatch[axis], sel, columns, nuisance, inner).items()})
     return sel, by_key
 
 
@@ -497,9 +503,32 @@ def _impractical_reason(share: float) -> str:
     return f"entered, but too small to matter: it explains {cand.share_below_practical(share)}"
 
 
+def _stands_ar(ar_t: dict, axis: str, t) -> bool:
+    v = ar_t.get((axis, t.name))
+    return v is None or abs(v) >= cand.AR_ENTRY_T
+
+
+def not_entered_reason(share: float, t_ar: float | None) -> str:
+    """Why a term the stepwise entered is not a candidate finding: too small to matter, or
+    not standing with the AR residual autocorrelation (:data:`candidates.AR_ENTRY_T`)."""
+    if not _practical(share):
+        return _impractical_reason(share)
+    return (f"entered, but with the residual's autocorrelation from an autoregressive model of it t = {t_ar:.1f}, "
+            f"under the entry t of {cand.AR_ENTRY_T:g}: the sample autocorrelation (seed Eq. 39) reads the error of "
+            "a column whose power lies in a few frequencies too small there")
+
+
 def aero_candidates(selections: dict, delays: dict, dt: float,
-                    shares: dict[tuple[str, str], float] | None = None) -> list[Candidate]:
+                    shares: dict[tuple[str, str], float] | None = None,
+                    ar_t: dict[tuple[str, str], float] | None = None) -> list[Candidate]:
+    """The stepwise fits' terms as candidates: a term is selected when it entered, matters
+    (its share of the coefficient's excursion) and stands with the AR residual
+    autocorrelation too (``ar_t``, :data:`candidates.AR_ENTRY_T`)."""
     shares = shares or {}
+    ar_t = ar_t or {}
+
+    def _practical_here(axis: str, t) -> bool:
+        return _practical(shares.get((axis, t.name), 0.0)) and _stands_ar(ar_t, axis, t)
     out: list[Candidate] = []
     delay_seen: dict[str, list] = {}
     cg_seen: list = []
@@ -516,8 +545,9 @@ def aero_candidates(selections: dict, delays: dict, dt: float,
             if term.effect == "coefficient_error":
                 est = term.details["model_value"] + t.estimate
             share = shares.get((axis, t.name), 0.0)
-            sel = t.selected and _practical(share)
-            reason = ("entered" if sel else _impractical_reason(share) if t.selected else "not entered")
+            sel = t.selected and _practical_here(axis, t)
+            reason = ("entered" if sel else not_entered_reason(share, ar_t.get((axis, t.name)))
+                      if t.selected else "not entered")
             out.append(Candidate(term.effect, cand.AXIS_NAME[axis], axis, term.parameter, est, se, t.t, t.gain,
                                  term.units, f"stepwise on the {axis} mismatch", sel, reason,
                                  ({"change": t.estimate, "model_over_maneuver": term.details["model_value"],
@@ -528,7 +558,7 @@ def aero_candidates(selections: dict, delays: dict, dt: float,
         # significance from the stepwise entry of the delay column (its coefficient is τ);
         # size and standard error from the scan's linearised fit
         best = max(rows, key=lambda r: abs(r[1].t))[1]
-        entered = any(t.selected and _practical(shares.get((a, t.name), 0.0)) for a, t in rows)
+        entered = any(t.selected and _practical_here(a, t) for a, t in rows)
         inside = scan.tau_s <= cand.DELAY_GRID_S[-1]
         sel = entered and inside and scan.tau_s >= practical_delay(dt)
         gain = max(t.gain for _, t in rows)
@@ -542,9 +572,10 @@ def aero_candidates(selections: dict, delays: dict, dt: float,
                              {"axes": [a for a, _ in rows], "scan_t": scan.t, "stepwise_t": best.t}))
     if cg_seen:
         axis, t, term = max(cg_seen, key=lambda r: abs(r[1].t))
-        sel = any(r[1].selected and _practical(shares.get((r[0], r[1].name), 0.0)) for r in cg_seen)
+        sel = any(r[1].selected and _practical_here(r[0], r[1]) for r in cg_seen)
         out.append(Candidate("cg_offset", cand.AXIS_NAME[axis], axis, term.parameter, t.estimate * term.scale,
                              abs(t.std_error * term.scale), t.t, t.gain, "ft", f"stepwise on the {axis} mismatch",
-                             sel, "entered" if sel else (_impractical_reason(shares.get((axis, t.name), 0.0))
+                             sel, "entered" if sel else (not_entered_reason(shares.get((axis, t.name), 0.0),
+                                                                            ar_t.get((axis, t.name)))
                                                          if t.selected else "not entered")))
     return out
