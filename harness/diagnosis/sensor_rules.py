@@ -567,7 +567,7 @@ def kinematic_rival(kin: KinematicResult, name: str, min_correlation: float | No
 KINEMATIC_RIVAL_CORRELATION = 0.7
 
 
-def _still_preferred(found: tuple) -> bool:
+def still_preferred(found: tuple) -> bool:
     """Beside its rival (:func:`kinematic_rival`'s ``found``) the data still prefer the selected
     term: it keeps |t| >= :data:`AMBIGUOUS_T` while the rival falls below it, and the rival alone
     would not have entered (|t| < the kinematic entry t in the term's place). Where it would, the
@@ -589,7 +589,7 @@ def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dic
     out = {}
     for n in kin.selection.names:
         found = kinematic_rival(kin, n)
-        if found is not None and found[2] < KIN_T_IN and not _still_preferred(found):
+        if found is not None and found[2] < KIN_T_IN and not still_preferred(found):
             out[n] = Contest(*found[:3], rival_estimate=found[4])
             continue
         exact = skew_rival(kin, p, n) if p is not None else None
@@ -606,7 +606,7 @@ def biases_of_contested(kin: KinematicResult, contested: dict[str, Contest]) -> 
     :data:`APPLY_T` with its rival fitted in its place (an α scale factor shifts α's mean by
     k·ᾱ, which the α bias then takes). Applied while the term is not, such a bias moves the
     model along a part of an error the data may not have: the T-37 of
-    :func:`_still_preferred`, its α scale contested, had the α bias of +0.14° that the scale
+    :func:`still_preferred`, its α scale contested, had the α bias of +0.14° that the scale
     left (t 7.5) applied, and the curvature of its drag table read the shift as a C_X,α change
     of +0.028 (t 11.3)."""
     out = set()
