@@ -12,7 +12,9 @@ import pytest
 
 from estimators.colored_stepwise import colored_fit
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.sensor_rules import Contest, biases_of_contested, still_preferred
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, biases_of_contested, contested_parameters,
+                                            kinematic_rival, rival_enters_alone, still_preferred)
 from harness.diagnosis.stepwise_axes import aero_candidates
 
 
@@ -20,11 +22,28 @@ def test_a_rival_that_enters_alone_is_no_longer_outvoted_beside_the_term():
     """The T-37 of the docstring: beside the a_z skew the α scale keeps t 5.0 and the skew falls
     to 0.3, but the skew alone stands at 7.5: the pair is contested. A rival that alone stays
     under the entry t does not contest."""
-    assert not still_preferred(("skew_az", -0.81, 5.0, 0.3, (0.036, 7.5)))
-    assert still_preferred(("skew_az", -0.81, 5.0, 0.3, (0.01, 2.0)))
-    assert still_preferred(("skew_az", -0.81, 5.0, 0.3, None))
+    found = ("skew_az", -0.81, 5.0, 0.3, (0.036, 7.5))
+    assert still_preferred(found) and rival_enters_alone(found)
+    assert not rival_enters_alone(("skew_az", -0.81, 5.0, 0.3, (0.01, 2.0)))
+    assert not rival_enters_alone(("skew_az", -0.81, 5.0, 0.3, None))
+    # only a time skew's linearised column is so distrusted: the Twin Otter's accelerometer
+    # position beside a β vane ahead of the c.g. stays with the t beside each other
+    assert not rival_enters_alone(("vane_beta_x", -0.97, 4.0, 1.0, (5.3, 6.9)))
     assert not still_preferred(("skew_az", -0.81, 2.0, 0.3, None))  # the term itself too weak beside it
     assert not still_preferred(("skew_az", -0.81, 5.0, 3.0, None))  # the rival still stands beside it
+    n = 3000
+    rival = np.sin(np.linspace(0.0, 40.0, n))
+    term = rival + 0.5 * np.sin(np.linspace(0.0, 23.0, n))  # r = 0.89
+    kin = SimpleNamespace(columns={"scale_alpha": term, "skew_az": rival}, forced=(),
+                          selection=SimpleNamespace(names=("scale_alpha",)))
+    noise = np.random.default_rng(3).normal(size=n)
+    kin.start = 0.05 * term + 0.02 * noise  # the term's own record: it stands beside the rival
+    assert contested_parameters(kin) == {}
+    kin.start = 0.01 * term + 0.04 * noise  # beside it the term keeps 2.5-6, the rival alone would enter
+    found = kinematic_rival(kin, "scale_alpha")
+    assert AMBIGUOUS_T <= found[2] < KIN_T_IN and found[3] < AMBIGUOUS_T and found[4][1] >= KIN_T_IN, found
+    got = contested_parameters(kin)
+    assert got["scale_alpha"].rival == "skew_az" and "alone in its place" in got["scale_alpha"].why
 
 
 def test_a_bias_that_only_offsets_a_contested_scale_is_not_applied():

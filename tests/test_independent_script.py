@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from harness.diagnosis import analysis
+from harness.diagnosis import candidates as cand
 from harness.diagnosis.run import diagnose
 from independent_script import G0, fly, inputs
 
@@ -513,20 +515,26 @@ def _without_column(path, column: str) -> None:
         csv.writer(fh).writerows([row[:j] + row[j + 1:] for row in rows])
 
 
-def test_a_term_resting_on_an_uncertain_alpha_correction_is_not_named(tmp_path):
+def test_a_term_resting_on_an_uncertain_alpha_correction_is_not_named(tmp_path, monkeypatch):
     """The package's c182 (5,080 ft / 168 ft/s, doublets at 25 Hz, half the noise, no h
     channel, doublet validation) with p 40 ms late: the skew itself is under its practical
     size (1.2 samples) and not named, but the kinematics applied an α bias of 0.52° beside it
     (t 3.1), and along the α so corrected the model's C_n,p̂, which follows α, left a C_n,p̂
     change of −0.018 (t −8.4), −0.003 without the correction. A term that correction, moved
     within three of its standard errors, takes half of is withheld
-    (term_rules.withhold_resting_on_an_uncertain_correction)."""
+    (term_rules.withhold_resting_on_an_uncertain_correction). Since the thirty-fourth session
+    the bias is not applied at all (the p skew is contested by a φ skew, and with that in its
+    place the bias falls under 3, sensor_rules.biases_of_contested) and C_n,p̂ does not enter;
+    the rule is pinned with the bias applied as before."""
     model = _package_xml("c182")
     rec, val = _pair(tmp_path, "c182", 5080.0, 168.2, 174, 25.0, "dbl3", noise=0.5, amplitude_deg=3.43)
     for path in (rec, val):
         _sensor_error(path, "p_rps", lambda t, x: np.interp(t - 0.04, t, x))
         _without_column(path, "h_ft")
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert {p for p, _ in _found(result)} <= {"skew_p"}
+    monkeypatch.setattr(analysis, "biases_of_contested", lambda kin, contested: set())
+    result = diagnose(model, rec, tmp_path / "out_applied", val, calibrate=False)
     assert {p for p, _ in _found(result)} <= {"skew_p"}
     term = next(c for c in result["candidates"] if c["parameter"] == "Cn_phat")
     assert not term["selected"] and "rests on the correction for bias_alpha" in term["reason"], term["reason"]
@@ -824,13 +832,16 @@ def test_a_surface_term_a_noisy_rate_column_rivals_below_the_seed_s_limit_is_not
     assert {p for p, _ in _found(result)} <= {"Cm_qhat"}
 
 
-def test_a_pitch_drift_the_vane_s_unseen_wander_makes_is_not_named(tmp_path):
+def test_a_pitch_drift_the_vane_s_unseen_wander_makes_is_not_named(tmp_path, monkeypatch):
     """The package's T-6 (8,600 ft / 347 ft/s, doublets on each axis at 50 Hz, metric), a
     null: C_m ΔV/V +0.22 was named (t 6.9), 0.003 with the vane noise-free. The vane's error
     column the fit carries is high-passed at 0.05 Hz; the wander below, left in the mismatch,
     follows the airspeed's one slow swing by chance, and sized from the column's spectrum
     above the high-pass it gives the term a standard error of 0.1 beside the fit's 0.03
-    (wander_rules.withhold_within_the_unseen_wander). Now `none`."""
+    (wander_rules.withhold_within_the_unseen_wander). Now `none`. Since the thirty-fourth
+    session the AR errors' entry t withholds it first (t 4.5, candidates.AR_ENTRY_T); the
+    wander rule is pinned with that entry off."""
+    monkeypatch.setattr(cand, "AR_ENTRY_T", 0.0)
     model = _package_xml("t6texan2")
     rec, val = _pair(tmp_path, "t6texan2", 8577.0, 346.5, 729, 50.0, "dbl3", units="metric", noise=1.0,
                      amplitude_deg=2.77)

@@ -557,12 +557,15 @@ def independent_c172x_recording(path: Path, seed: int, sim_hz: float = 100.0, du
     path.with_suffix(".meta.json").write_text(json.dumps(meta))
 
 
-def test_a_force_drift_the_vane_wander_imitates_is_not_named(tmp_path):
+def test_a_force_drift_the_vane_wander_imitates_is_not_named(tmp_path, monkeypatch):
     """An independent script's c172x null (seed 21): the α vane's 1 s wander, passed through
     the model's ∂C_Z/∂α, followed the airspeed's slow change and the stepwise entered a C_Z
     ΔV/V (t 5.0). Beside that column (term_rules.withhold_force_drift_off_the_vane_wander) it
-    falls to t 2.6: none."""
+    falls to t 2.6: none. Since the thirty-fourth session the AR errors' entry t withholds it
+    first (candidates.AR_ENTRY_T); the wander rule is pinned with that entry off."""
+    from harness.diagnosis import candidates as cand
     from harness.diagnosis.run import diagnose
+    monkeypatch.setattr(cand, "AR_ENTRY_T", 0.0)
     path = tmp_path / "c172x.csv"
     independent_c172x_recording(path, 21)
     result = diagnose("c172x", path, tmp_path / "out", calibrate=False)

@@ -569,27 +569,39 @@ KINEMATIC_RIVAL_CORRELATION = 0.7
 
 def still_preferred(found: tuple) -> bool:
     """Beside its rival (:func:`kinematic_rival`'s ``found``) the data still prefer the selected
-    term: it keeps |t| >= :data:`AMBIGUOUS_T` while the rival falls below it, and the rival alone
-    would not have entered (|t| < the kinematic entry t in the term's place). Where it would, the
-    colored t beside each other is no verdict: an independent script's T-37 (5,800 ft / 343 ft/s,
-    pitch frequency sweep at 100 Hz) with a_z 40 ms late had an α scale of −0.098 named (t 10.1;
-    beside the a_z skew t 5.0, the skew 0.3) while the skew alone stood at 36 ms, t 7.5; without
-    the noise on V, h and θ that took the h equation's weight the skew was named (39.7 ms)."""
-    _, _, t_own, t_rival, alone = found
-    return t_own >= AMBIGUOUS_T and t_rival < AMBIGUOUS_T and not (alone is not None and alone[1] >= KIN_T_IN)
+    term: it keeps |t| >= :data:`AMBIGUOUS_T` while the rival falls below it."""
+    _, _, t_own, t_rival, _ = found
+    return t_own >= AMBIGUOUS_T and t_rival < AMBIGUOUS_T
+
+
+def rival_enters_alone(found: tuple) -> bool:
+    """The rival, a time skew, fitted alone in the term's place (:func:`kinematic_rival`'s
+    ``found``) would have entered (|t| >= the kinematic entry t): then the colored t of the two
+    beside each other is no verdict, for the skew's first-order column lives in one equation (an
+    a_z skew in ẇ's, the most coloured residual) and leaves out the τ²ẍ/2 of its exact shift
+    (:mod:`exact_skew`). An independent script's T-37 (5,800 ft / 343 ft/s, pitch frequency
+    sweep at 100 Hz) with a_z 40 ms late had an α scale of −0.098 named (t 10.1; beside the a_z
+    skew t 5.0, the skew 0.3) while the skew alone stood at 36 ms, t 7.5; without the noise on
+    V, h and θ that took the h equation's weight the skew was named (39.7 ms). Other rivals are
+    left to the t beside each other: the Twin Otter's accelerometer position (t 4.0 beside a β
+    vane ahead of the c.g., which alone stands at 6.9) is named from its force mismatch as before."""
+    alone = found[4]
+    return found[0].startswith("skew_") and alone is not None and alone[1] >= KIN_T_IN
 
 
 def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dict[str, Contest]:
     """The selected kinematic terms the kinematics cannot tell from a rival
     (:func:`kinematic_rival`: |t| beside it below their entry t, unless it stays at least
-    :data:`AMBIGUOUS_T` there while the rival falls below it), and, given the recording ``p``,
+    :data:`AMBIGUOUS_T` there while the rival falls below it), given the recording ``p``
     those a collinear time skew applied as the exact shift fits better
-    (:func:`exact_skew.skew_rival`): not applied to the channels, so that the coefficient
-    mismatch can judge between the two (:func:`kinematic_rivals`)."""
+    (:func:`exact_skew.skew_rival`), and those still preferred beside a rival that would have
+    entered alone (:func:`rival_enters_alone`): not applied to the channels, so that the
+    coefficient mismatch can judge between the two (:func:`kinematic_rivals`)."""
     out = {}
     for n in kin.selection.names:
         found = kinematic_rival(kin, n)
-        if found is not None and found[2] < KIN_T_IN and not still_preferred(found):
+        beside = found is not None and found[2] < KIN_T_IN
+        if beside and not still_preferred(found):
             out[n] = Contest(*found[:3], rival_estimate=found[4])
             continue
         exact = skew_rival(kin, p, n) if p is not None else None
@@ -598,6 +610,10 @@ def contested_parameters(kin: KinematicResult, p: Prepared | None = None) -> dic
                              f"the exact shift of {exact.rival} at {1000 * exact.tau:.1f} ms leaves less kinematic "
                              f"residual ({exact.rss_skew:.0f} against {exact.rss_term:.0f}) than its first-order "
                              "column lets the linearised fit see")
+        elif beside and rival_enters_alone(found):
+            out[n] = Contest(*found[:3], rival_estimate=found[4],
+                             why=f"beside it t = {found[2]:.1f}; alone in its place {found[0]} stands at "
+                                 f"t = {found[4][1]:.1f}")
     return out
 
 
@@ -606,7 +622,7 @@ def biases_of_contested(kin: KinematicResult, contested: dict[str, Contest]) -> 
     :data:`APPLY_T` with its rival fitted in its place (an α scale factor shifts α's mean by
     k·ᾱ, which the α bias then takes). Applied while the term is not, such a bias moves the
     model along a part of an error the data may not have: the T-37 of
-    :func:`still_preferred`, its α scale contested, had the α bias of +0.14° that the scale
+    :func:`rival_enters_alone`, its α scale contested, had the α bias of +0.14° that the scale
     left (t 7.5) applied, and the curvature of its drag table read the shift as a C_X,α change
     of +0.028 (t 11.3)."""
     out = set()
