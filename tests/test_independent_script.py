@@ -540,6 +540,25 @@ def test_a_term_resting_on_an_uncertain_alpha_correction_is_not_named(tmp_path, 
     assert not term["selected"] and "rests on the correction for bias_alpha" in term["reason"], term["reason"]
 
 
+def test_a_term_a_whole_uncertain_correction_makes_is_not_named(tmp_path, monkeypatch):
+    """The package's c182, a null (5,010 ft / 196 ft/s, 3-2-1-1 on each axis at 50 Hz, half the
+    noise, no h channel): the kinematics applied an α bias of 0.45° at t 3.8, and along the α so
+    corrected C_n,p̂ came out 0.015 more negative than the model's (t −15), named. Moved by three
+    of its errors the correction took 0.006 of that away, under half; removed, all of it. A
+    correction under the entry t is not established: removing it counts too
+    (term_rules.withhold_resting_on_an_uncertain_correction, whole=True). Now `none`."""
+    model = _package_xml("c182")
+    _with_multisteps(monkeypatch)
+    rec, val = _pair(tmp_path, "c182", 5010.0, 195.6, 1801, 50.0, "3211_3", noise=0.5, amplitude_deg=3.42)
+    for path in (rec, val):
+        _without_column(path, "h_ft")
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert _found(result) == []
+    term = next(c for c in result["candidates"] if c["parameter"] == "Cn_phat")
+    assert abs(term["t"]) >= 5.0 and not term["selected"]
+    assert "rests on the correction for bias_alpha" in term["reason"] and "or removed" in term["reason"], term["reason"]
+
+
 def test_a_suspicion_lifted_leaves_a_term_another_rival_imitates_withheld(tmp_path, monkeypatch):
     """The package's T-6 null (11,639 ft / 408 ft/s, 3-2-1-1 on each axis at 50 Hz in
     degrees, doublet validation): C_m,q̂ came out 2.5 over the model's (t 11), was withheld for

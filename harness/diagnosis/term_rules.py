@@ -896,10 +896,13 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         A = np.column_stack(cols + [np.ones(z.size)])
         return float(np.linalg.lstsq(A, z, rcond=None)[0][0])
 
-    def part(c: Candidate, name: str, at: tuple[float, float] | None = None) -> tuple[float, float] | None:
+    def part(c: Candidate, name: str, at: tuple[float, float] | None = None,
+             removed: bool = False) -> tuple[float, float] | None:
         """(centre, half-width) of what error ``name`` imitates of ``c``'s change, in its
         direction: per_v·v and IMITATION_Z·|per_v|·σ; v ± σ the kinematic estimate, or ``at``
-        (an error named on two tests, at its combined size)."""
+        (an error named on two tests, at its combined size). ``removed``: the channels already
+        carry the correction v, and per_v is measured by taking it out again (the term's
+        estimate with the correction less the one without), not by doubling it."""
         if name == EULER_LAG:  # probed at the largest lag allowed; the interval's ends below
             lag = euler_lag_estimate(p, kin, applied)
             found = None if lag is None else (lag.high, 1.0, 0.0)
@@ -916,7 +919,7 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         if name == EULER_LAG:
             corrected = rate_derivatives_advanced(p, v)
         else:
-            corrected = corrected_recording(p, kin, {m: v for m in unit_members(kin, name)})
+            corrected = corrected_recording(p, kin, {m: -v if removed else v for m in unit_members(kin, name)})
         # an inertial α the model follows is rebuilt from the corrected channels: the error's
         # own path into the model's states (inertial_alpha_sensors)
         changed = model_along(corrected, aircraft, ic, inertial_from=None if follows_inertial_alpha else p).mismatch()
@@ -932,7 +935,8 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         else:
             before = refit(mismatch[c.channel][inner], cols + fixed)
             after = refit(changed[c.channel][inner], cols + fixed)
-        per_v = (before - after) / v   # what an error of size v adds to the term's estimate
+        # what an error of size v adds to the term's estimate (removed: what its correction added)
+        per_v = (before - after) / v
         if lag is not None:  # the most any lag allowed imitates: the interval's ends, as (centre, half-width)
             ends = [per_v * x * np.sign(change) for x in (lag.low, lag.high)]
             return 0.5 * (ends[0] + ends[1]), 0.5 * abs(ends[0] - ends[1])
@@ -940,19 +944,23 @@ def imitation(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic: Initial
         return per_v * v * np.sign(change), IMITATION_Z * abs(per_v) * sigma
 
     def imitated(c: Candidate, name: str | tuple[str, ...], at: tuple[float, float] | None = None,
-                 applied: bool = False) -> float | None:
+                 applied: bool = False, whole: bool = False) -> float | None:
         """The most ``name`` imitates within IMITATION_Z standard errors (of ``at``, estimate
         and standard error, when given); for several errors at once (a tuple), within that
         many of their joint estimate (independent: the centres add, the half-widths in
         quadrature). ``applied``: the error is already corrected for at its estimate, and
         what counts is how much of the change moving that correction within IMITATION_Z
-        standard errors can take away (the half-width alone)."""
+        standard errors can take away (the half-width alone); ``whole`` as well: or removing
+        the correction altogether (the centre)."""
         names = (name,) if isinstance(name, str) else name
-        parts = [part(c, n, at) for n in names]
+        parts = [part(c, n, at, removed=applied) for n in names]
         if any(x is None for x in parts):
             return None
         spread = float(np.sqrt(sum(x[1] ** 2 for x in parts)))
-        return spread if applied else sum(x[0] for x in parts) + spread
+        centre = sum(x[0] for x in parts)
+        if applied:
+            return max(spread, centre) if whole else spread
+        return centre + spread
     return imitated
 
 
@@ -962,11 +970,16 @@ def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: Kin
     without being sure of it: a value applied from |t| :data:`sensor_rules.APPLY_T` on but
     below the kinematic entry t (:data:`kinematics.T_IN`), which moved within
     :data:`IMITATION_Z` of its standard errors would take at least
-    :data:`IMITATION_SHARE` of the term's change away (``imitated(..., applied=True)``,
-    :func:`imitation`). An independent script's c182 (168 ft/s, doublets, 25 Hz) with p
-    40 ms late had an α bias of 0.52° applied at kinematic t 3.1 (the skew's doing, the skew
-    itself under its practical size); along the α so corrected the model's C_n,p̂, which
-    follows α, left a C_n,p̂ change of −0.018 (t −8.4), −0.003 without the correction."""
+    :data:`IMITATION_SHARE` of the term's change away, or would without the correction at all
+    (``imitated(..., applied=True, whole=True)``, :func:`imitation`): a correction under the
+    entry t is not established, and a term that rests on it is not either. An independent
+    script's c182 (168 ft/s, doublets, 25 Hz) with p 40 ms late had an α bias of 0.52°
+    applied at kinematic t 3.1 (the skew's doing, the skew itself under its practical size);
+    along the α so corrected the model's C_n,p̂, which follows α, left a C_n,p̂ change of
+    −0.018 (t −8.4), −0.003 without the correction. Another c182, a null (5,100 ft, 3-2-1-1 on
+    each axis at 50 Hz, half the noise, no h), had an α bias of 0.67° ± 0.15° applied (t 4.6):
+    moved by three of its errors it took 0.006 of a C_n,p̂ change of −0.015 (t −15), removed,
+    all of it (the C_n,p̂ estimate moves by −1.9 per rad of the α correction)."""
     unsure = {n: v for n, v in applied.items() if kinematic_t(kin, n) < KIN_T_IN}
     if imitated is None or not unsure:
         return
@@ -977,7 +990,7 @@ def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: Kin
         change = abs(term_change(c))
         for name, v in unsure.items():
             se = kinematic_std_error(kin, name)
-            size = imitated(c, name, (v, se), applied=True) if np.isfinite(se) and se > 0 else None
+            size = imitated(c, name, (v, se), applied=True, whole=True) if np.isfinite(se) and se > 0 else None
             if size is None or size < IMITATION_SHARE * change:
                 continue
             c.selected = False
@@ -985,9 +998,9 @@ def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: Kin
             c.details["uncertain_correction"] = {"parameter": name, "applied": v, "std_error": se,
                                                  "imitates_at_most": size, "change": change}
             c.reason = (f"entered, but not named: it rests on the correction for {_named(name)} = {v:.3g} ± {se:.2g} "
-                        f"(kinematic t = {abs(v) / se:.1f}, applied though below the entry t); within "
-                        f"{IMITATION_Z:g} of its standard errors that correction takes {size:.2g} of this change "
-                        f"of {change:.3g} away")
+                        f"(kinematic t = {abs(v) / se:.1f}, applied though below the entry t); moved within "
+                        f"{IMITATION_Z:g} of its standard errors, or removed, that correction takes {size:.2g} of this "
+                        f"change of {change:.3g} away")
             break
 
 
