@@ -74,3 +74,29 @@ def test_a_kinematic_rival_is_sized_in_the_place_of_the_term_it_contests():
     name, r, t_own, t_rival, alone = kinematic_rival(kin, "scale_alpha")
     assert name == "skew_az" and abs(r) > 0.9
     assert alone[0] == pytest.approx(0.04, rel=0.05) and alone[1] > 10.0
+
+
+def test_the_positions_rival_is_not_named_where_neither_stands_beside_the_other():
+    """The force mismatch could not tell the accelerometer's position from a C_Y,β change (the
+    position t 4.3 beside it): the change, left to the stepwise fit, is withheld when it too
+    falls under the entry t beside the position (t 4.0), and kept where it stands (t 7.2, a true
+    C_Y,β change read as an accelerometer aft)."""
+    from harness.diagnosis.accelerometer_rules import withhold_the_positions_rival
+
+    def cands(t_rival):
+        off = Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", 1.56, 0.15, 10.2, 0.1, "ft",
+                        "force mismatch on ω̇×r + ω×(ω×r)", False, "not named",
+                        {"offset_rival": "CY_beta", "offset_rival_t": t_rival, "offset_t_beside": 4.3})
+        cy = Candidate("coefficient_error", "lat", "CY", "CY_beta", -0.905, 0.0013, 88.0, 0.3, "1/rad",
+                       "stepwise on the CY mismatch", True, "entered")
+        other = Candidate("coefficient_error", "lat", "CY", "CY_dr", -0.11, 0.005, -22.0, 0.1, "1/rad",
+                          "stepwise on the CY mismatch", True, "entered")
+        return [off, cy, other]
+
+    ambiguous = cands(4.0)
+    withhold_the_positions_rival(ambiguous)
+    assert not ambiguous[1].selected and "cannot tell it from the accelerometer" in ambiguous[1].reason
+    assert ambiguous[2].selected
+    standing = cands(-7.2)
+    withhold_the_positions_rival(standing)
+    assert standing[1].selected

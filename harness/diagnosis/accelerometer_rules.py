@@ -15,7 +15,7 @@ from harness.diagnosis.prepare import Prepared, interior_slice
 from harness.diagnosis.term_rules import left_impractical, term_change
 
 __all__ = ["KINEMATIC_POSITIONS", "note_refuted_positions", "refuted_positions", "term_beside_the_position",
-           "withhold_beside_the_accelerometer", "withhold_through_the_inertial_angles"]
+           "withhold_beside_the_accelerometer", "withhold_the_positions_rival", "withhold_through_the_inertial_angles"]
 
 
 # The kinematic check's accelerometer position components (effects.md's sensor_offset).
@@ -123,6 +123,31 @@ def withhold_beside_the_accelerometer(cands: list[Candidate], selections: dict, 
                     f"fitted beside the position (x = {x:.2f} ft) on the three force mismatches together it stands "
                     f"at t = {t:.1f}, under the entry t of {cand.T_IN:g}: it is the part of the position that fit "
                     "left")
+
+
+def withhold_the_positions_rival(cands: list[Candidate]) -> None:
+    """Deselect the stepwise terms of the coefficient error the force mismatch could not tell
+    from the accelerometer's position (``candidates.offset_rival``, the position's candidate
+    ``offset_rival``) when beside the position they fall below the entry t
+    (:data:`candidates.T_IN`) too: the position was not named for its rival, and its rival is
+    not named for the position. (Where the error stands beside the position, as a C_Y,β change
+    read as an accelerometer aft does, it stays.) An independent script's A-4 (8,400 ft /
+    514 ft/s, doublets on each axis at 50 Hz in a 27° bank, no h) with the accelerometer 4 ft
+    ahead had the position from the force mismatch at 1.6 ft beyond the kinematics' 2.2 ft,
+    t 4.3 beside a C_Y,β change and the change t 4.0 beside it; left to the stepwise fit, the
+    C_Y,β change of +0.118 was named first (t 88), the x·ṙ in a_y read as sideslip."""
+    off = next((c for c in cands if c.parameter == "x_accelerometer" and "offset_rival" in c.details), None)
+    if off is None or abs(off.details.get("offset_rival_t", np.inf)) >= cand.T_IN:
+        return
+    rivals = set(off.details["offset_rival"].split(" and "))
+    for c in cands:
+        if c.selected and c.test.startswith("stepwise") and c.parameter in rivals:
+            c.selected = False
+            c.details["sensor_rival"] = "x_accelerometer"
+            c.reason = (f"entered, but not named: the force mismatch cannot tell it from the accelerometer's position "
+                        f"(x = {off.estimate:.2f} ft): beside the position it stands at t = "
+                        f"{off.details['offset_rival_t']:.1f}, the position at t = {off.details['offset_t_beside']:.1f} "
+                        f"beside it, both under the entry t of {cand.T_IN:g}")
 
 
 # The axes each inertial angle reaches where the model follows it (along.model_states).

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refuted_positions,
-                                                   withhold_beside_the_accelerometer,
+                                                   withhold_beside_the_accelerometer, withhold_the_positions_rival,
                                                    withhold_through_the_inertial_angles)
 from harness.diagnosis.airspeed_rules import withhold_on_the_airspeed
 from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
@@ -127,6 +127,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     propeller = has_propeller(aircraft.model)
     step = stepwise_fits(p, propeller, aero, measured, mismatch, delays, vane)
     cands += aero_candidates(step.selections, delays, p.dt, step.shares, step.ar_t)
+    withhold_the_positions_rival(cands)
     name_the_delay_the_terms_imitate(cands, step, delays, p, mismatch)
     if not propeller:
         withhold_thrust_drift(cands, p, aero.trim)

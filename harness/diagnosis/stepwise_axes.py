@@ -49,7 +49,9 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
     return off, Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", x, sx,
                           x / sx if sx > 0 else 0.0, off.gain, "ft", "force mismatch on ω̇×r + ω×(ω×r)", sel, reason,
                           {"position_ft": list(off.position_ft), "std_error_ft": list(off.std_error_ft),
-                           "t_xyz": list(off.t)} | ({"offset_rival": rival.parameter} if rival else {}))
+                           "t_xyz": list(off.t)}
+                          | ({"offset_rival": rival.parameter, "offset_rival_t": rival.t_rival,
+                              "offset_t_beside": rival.t_offset} if rival else {}))
 
 
 def delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
