@@ -81,7 +81,8 @@ def test_import_sidpac(tmp_path, shared_dir):
 
 
 def test_demo_prints_truth_and_recording_path(tmp_path, capsys):
-    assert main(["demo", "--out", str(tmp_path)]) == 0
+    # 20 realizations on one worker: the main job end to end (`make demo` runs its 100)
+    assert main(["demo", "--out", str(tmp_path), "--realizations", "20", "--workers", "1"]) == 0
     out = capsys.readouterr().out
     assert "Cm_alpha" in out and "Recording:" in out
     assert (tmp_path / "f16_stabilator_2112.csv").is_file()
