@@ -144,10 +144,10 @@ def withhold_the_positions_rival(cands: list[Candidate]) -> None:
         if c.selected and c.test.startswith("stepwise") and c.parameter in rivals:
             c.selected = False
             c.details["sensor_rival"] = "x_accelerometer"
+            t_term, t_position = off.details["offset_rival_t"], off.details["offset_t_beside"]
             c.reason = (f"entered, but not named: the force mismatch cannot tell it from the accelerometer's position "
-                        f"(x = {off.estimate:.2f} ft): beside the position it stands at t = "
-                        f"{off.details['offset_rival_t']:.1f}, the position at t = {off.details['offset_t_beside']:.1f} "
-                        f"beside it, both under the entry t of {cand.T_IN:g}")
+                        f"(x = {off.estimate:.2f} ft): beside the position it stands at t = {t_term:.1f}, the position "
+                        f"at t = {t_position:.1f} beside it, both under the entry t of {cand.T_IN:g}")
 
 
 # The axes each inertial angle reaches where the model follows it (along.model_states).
