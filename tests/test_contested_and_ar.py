@@ -1,5 +1,5 @@
-"""Three rules that keep noise from being named: a kinematic rival that would have entered on
-its own contests the term it stands beside (sensor_rules.still_preferred), the nuisance biases
+"""Three rules that keep noise from being named: a time-skew rival that would have entered on
+its own contests the term it stands beside (sensor_rules.rival_enters_alone), the nuisance biases
 that lean on a contested term are not applied (sensor_rules.biases_of_contested), and a stepwise
 term must also stand with the residual autocorrelation of an autoregressive model
 (candidates.autoregressive_t)."""

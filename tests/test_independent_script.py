@@ -544,7 +544,7 @@ def test_a_term_a_whole_uncertain_correction_makes_is_not_named(tmp_path, monkey
     """The package's c182, a null (5,010 ft / 196 ft/s, 3-2-1-1 on each axis at 50 Hz, half the
     noise, no h channel): the kinematics applied an α bias of 0.45° at t 3.8, and along the α so
     corrected C_n,p̂ came out 0.015 more negative than the model's (t −15), named. Moved by three
-    of its errors the correction took 0.006 of that away, under half; removed, all of it. A
+    of its errors the correction took under half of that away; removed, 0.012 of it. A
     correction under the entry t is not established: removing it counts too
     (term_rules.withhold_resting_on_an_uncertain_correction, whole=True). Now `none`."""
     model = _package_xml("c182")
@@ -860,11 +860,15 @@ def test_a_pitch_drift_the_vane_s_unseen_wander_makes_is_not_named(tmp_path, mon
     (wander_rules.withhold_within_the_unseen_wander). Now `none`. Since the thirty-fourth
     session the AR errors' entry t withholds it first (t 4.5, candidates.AR_ENTRY_T); the
     wander rule is pinned with that entry off."""
-    monkeypatch.setattr(cand, "AR_ENTRY_T", 0.0)
     model = _package_xml("t6texan2")
     rec, val = _pair(tmp_path, "t6texan2", 8577.0, 346.5, 729, 50.0, "dbl3", units="metric", noise=1.0,
                      amplitude_deg=2.77)
     result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert _found(result) == []
+    drift = next(c for c in result["candidates"] if c["parameter"] == "Cm_dV")
+    assert not drift["selected"] and "autoregressive" in drift["reason"], drift["reason"]
+    monkeypatch.setattr(cand, "AR_ENTRY_T", 0.0)
+    result = diagnose(model, rec, tmp_path / "out_sample_errors", val, calibrate=False)
     assert _found(result) == []
     drift = next(c for c in result["candidates"] if c["parameter"] == "Cm_dV")
     assert not drift["selected"] and "wander" in drift["reason"], drift["reason"]

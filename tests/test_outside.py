@@ -565,10 +565,14 @@ def test_a_force_drift_the_vane_wander_imitates_is_not_named(tmp_path, monkeypat
     first (candidates.AR_ENTRY_T); the wander rule is pinned with that entry off."""
     from harness.diagnosis import candidates as cand
     from harness.diagnosis.run import diagnose
-    monkeypatch.setattr(cand, "AR_ENTRY_T", 0.0)
     path = tmp_path / "c172x.csv"
     independent_c172x_recording(path, 21)
     result = diagnose("c172x", path, tmp_path / "out", calibrate=False)
+    assert [f["effect"] for f in result["findings"]] == ["none"]
+    drift = next(c for c in result["candidates"] if c["parameter"] == "CZ_dV")
+    assert not drift["selected"] and "autoregressive" in drift["reason"], drift["reason"]
+    monkeypatch.setattr(cand, "AR_ENTRY_T", 0.0)
+    result = diagnose("c172x", path, tmp_path / "out_sample_errors", calibrate=False)
     assert [f["effect"] for f in result["findings"]] == ["none"]
     drift = next(c for c in result["candidates"] if c["parameter"] == "CZ_dV")
     assert not drift["selected"] and "vane's wander" in drift["reason"]

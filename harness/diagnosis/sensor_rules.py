@@ -584,7 +584,7 @@ def rival_enters_alone(found: tuple) -> bool:
     skew t 5.0, the skew 0.3) while the skew alone stood at 36 ms, t 7.5; without the noise on
     V, h and θ that took the h equation's weight the skew was named (39.7 ms). Other rivals are
     left to the t beside each other: the Twin Otter's accelerometer position (t 4.0 beside a β
-    vane ahead of the c.g., which alone stands at 6.9) is named from its force mismatch as before."""
+    vane ahead of the c.g., which alone stands at 6.9) is named by the kinematics as before."""
     alone = found[4]
     return found[0].startswith("skew_") and alone is not None and alone[1] >= KIN_T_IN
 
@@ -623,8 +623,8 @@ def biases_of_contested(kin: KinematicResult, contested: dict[str, Contest]) -> 
     k·ᾱ, which the α bias then takes). Applied while the term is not, such a bias moves the
     model along a part of an error the data may not have: the T-37 of
     :func:`rival_enters_alone`, its α scale contested, had the α bias of +0.14° that the scale
-    left (t 7.5) applied, and the curvature of its drag table read the shift as a C_X,α change
-    of +0.028 (t 11.3)."""
+    left (t 7.5) applied, and along the α so shifted C_X's mismatch read a C_X,α change of +0.028
+    (t 11.3); with the bias not applied C_X,α did not enter (t 1.8)."""
     out = set()
     for name, contest in contested.items():
         beside = kinematic_t_beside(kin, contest.rival, name) if contest.rival in (kin.columns or {}) else None

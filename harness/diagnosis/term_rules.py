@@ -977,9 +977,9 @@ def withhold_resting_on_an_uncertain_correction(cands: list[Candidate], kin: Kin
     applied at kinematic t 3.1 (the skew's doing, the skew itself under its practical size);
     along the α so corrected the model's C_n,p̂, which follows α, left a C_n,p̂ change of
     −0.018 (t −8.4), −0.003 without the correction. Another c182, a null (5,100 ft, 3-2-1-1 on
-    each axis at 50 Hz, half the noise, no h), had an α bias of 0.67° ± 0.15° applied (t 4.6):
-    moved by three of its errors it took 0.006 of a C_n,p̂ change of −0.015 (t −15), removed,
-    all of it (the C_n,p̂ estimate moves by −1.9 per rad of the α correction)."""
+    each axis at 50 Hz, half the noise, no h), had an α bias of 0.45° ± 0.12° applied (t 3.8):
+    moved by three of its errors it took under half of a C_n,p̂ change of −0.015 (t −15) away,
+    removed, 0.012 of it (with the correction not applied C_n,p̂ did not enter, t −2.0)."""
     unsure = {n: v for n, v in applied.items() if kinematic_t(kin, n) < KIN_T_IN}
     if imitated is None or not unsure:
         return
