@@ -259,6 +259,7 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
     suspects = sorted({c.details["sensor_rival"] for c in cands if not c.selected and "sensor_rival" in c.details}
                       | {c.parameter for c in cands if c.effect in SENSOR_EFFECTS and not c.selected
                          and c.reason == "below the entry t"})
+    named = []
     for name in suspects:
         sensor = next((c for c in cands if c.parameter == name), None)
         found = kinematic_estimate(kin, name)
@@ -269,11 +270,39 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
             continue
         verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN,
                                           tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
-        if not _name_if_corroborated(sensor, kin, p, verdict, t):
-            continue
+        if _name_if_corroborated(sensor, kin, p, verdict, t):
+            named.append(sensor)
+    withhold_corroborated_rivals(named, kin)
+    for sensor in named:
         for c in cands:
-            if c.details.get("sensor_rival") == name:
-                c.reason += f"; explained by the {name} named"
+            if sensor.selected and c.details.get("sensor_rival") == sensor.parameter:
+                c.reason += f"; explained by the {sensor.parameter} named"
+
+
+def withhold_corroborated_rivals(named: list[Candidate], kin: KinematicResult) -> None:
+    """Of two or more sensor errors named on the coefficient mismatch's corroboration
+    (:func:`name_corroborated`, each below the kinematic entry t and each tried alone), keep
+    only those that stay at :data:`AMBIGUOUS_T` or more fitted together in the kinematic
+    check (:func:`sensor_rules.kinematic_t_beside`): each was corroborated as if the other were
+    not there, and where the kinematics cannot tell them apart the mismatch a pair shares is
+    read twice. A probe's J3 Cub (113 ft/s, pitch multisine, noise 2) with its accelerometer
+    4 ft ahead had the position (kinematic t 4.5) and an a_z skew of −67 ms (5.4) both named;
+    together they stand at 1.0 and −2.1 (a_z's reading of x·q̇ follows ȧ_z on a pitch
+    maneuver)."""
+    if len(named) < 2:
+        return
+    together = kinematic_t_beside(kin, tuple(c.parameter for c in named))
+    if together is None:
+        return
+    for c in named:
+        t = together.get(c.parameter, np.inf)
+        if t >= AMBIGUOUS_T:
+            continue
+        others = ", ".join(o.parameter for o in named if o is not c)
+        c.selected = False
+        c.reason = (f"not named: the coefficient mismatch corroborates it, but the kinematics cannot tell it from "
+                    f"{others}, also corroborated: fitted together it stands at t = {t:.1f} (under "
+                    f"{AMBIGUOUS_T:g})")
 
 
 def kinematic_rivals(cands: list[Candidate], kin: KinematicResult, p: Prepared, signature,

@@ -396,12 +396,15 @@ def withhold_biases_an_airspeed_bias_makes(cands: list[Candidate], kin: Kinemati
                         "kinematics cannot tell them apart where the rates hold steady, as in a turn)")
 
 
-def kinematic_t_beside(kin: KinematicResult, added: str, dropped: str = "") -> dict[str, float] | None:
+def kinematic_t_beside(kin: KinematicResult, added: str | tuple[str, ...],
+                       dropped: str = "") -> dict[str, float] | None:
     """Each parameter's |t| in the kinematic fit of the forced and selected terms (``dropped``
-    left out) with ``added`` fitted beside them (colored-residual standard errors, no
-    constant); None when the columns are dependent."""
+    left out) with ``added`` (one name or several) fitted beside them (colored-residual
+    standard errors, no constant); None when the columns are dependent."""
     cols = kin.columns or {}
-    names = [n for n in kin.forced + kin.selection.names if n in cols and n not in (dropped, added)] + [added]
+    added = (added,) if isinstance(added, str) else added
+    names = [n for n in kin.forced + kin.selection.names if n in cols and n != dropped and n not in added]
+    names += [n for n in added if n in cols]
     try:
         theta, se, _ = colored_fit(kin.start, [cols[n] for n in names], names, constant=False)
     except (SingularRegressorsError, np.linalg.LinAlgError):

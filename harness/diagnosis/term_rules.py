@@ -179,9 +179,15 @@ def withhold_explained_by_force_arm(cands: list[Candidate], selections: dict, mi
     few per cent a c.g. or arm error puts beside it significant). An independent
     script's 737 (its reference point as its XML has it, 4.9 ft above and 1.2 ft aft of its
     loaded c.g.) with C_Y,β −0.25 per rad named C_Y,β −0.254 and, first, C_l,β −0.014: the
-    side force's roll about the c.g., −0.052 ΔC_Y."""
+    side force's roll about the c.g., −0.052 ΔC_Y. A force term left unnamed only because
+    the force mismatch cannot tell it from the accelerometer's position (``sensor_rival``)
+    counts too: a position error moves no moment, so a moment mismatch its arm explains is
+    that force's, not a second change (a probe's T-37, its reference point 0.73 ft above the
+    c.g., with C_Y,β −0.25 at noise 1 had C_Y,β withheld beside a position of −3.7 ft and
+    named C_l,β −0.006 in its place: −0.0216 ΔC_Y,β)."""
     named = {axis: [c for c in cands
-                    if c.selected and c.channel == axis and c.test == f"stepwise on the {axis} mismatch"]
+                    if (c.selected or c.details.get("sensor_rival") == "x_accelerometer") and c.channel == axis
+                    and c.test == f"stepwise on the {axis} mismatch"]
              for axis in ("CX", "CY", "CZ")}
     arm = reference_arm_ft(trim)
     if not any(named.values()) or not any(arm):
@@ -198,7 +204,8 @@ def withhold_explained_by_force_arm(cands: list[Candidate], selections: dict, mi
         delta["CX"] = delta.get("CX", 0.0) + lift_change_on_cx(delta["CZ"], p.smooth["alpha"])
     moments = moment_of_force_change(delta, arm, p.meta["geometry"])
     inner = interior(p)
-    forces = ", ".join(c.parameter for terms in named.values() for c in terms)
+    forces = ", ".join(c.parameter + ("" if c.selected else " (entered; unnamed beside the accelerometer's position)")
+                       for terms in named.values() for c in terms)
     for axis, moment in moments.items():
         if axis not in selections or not np.ndim(moment) or not np.any(moment):
             continue
@@ -214,7 +221,7 @@ def withhold_explained_by_force_arm(cands: list[Candidate], selections: dict, mi
             if fit is None or (abs(fit[1]) >= cand.T_IN and abs(fit[0]) > (1.0 - IMITATION_SHARE) * abs(change)):
                 continue
             c.selected = False
-            c.reason = (f"entered, but explained by the force change named ({forces}) acting at the model's "
+            c.reason = (f"entered, but explained by the force change ({forces}) acting at the model's "
                         f"aerodynamic reference point, {arm[0]:+.2f} ft forward and {arm[1]:+.2f} ft down of the "
                         f"c.g.: with its moment removed, {fit[0]:+.3g} (t = {fit[1]:.1f}) of {change:+.3g} is left")
 
