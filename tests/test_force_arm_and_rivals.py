@@ -60,6 +60,30 @@ def test_a_roll_the_side_force_change_makes_about_the_cg_is_not_a_cl_change():
             assert "reference point" in cl.reason
 
 
+def test_a_force_change_left_unnamed_beside_the_accelerometer_still_explains_its_moment():
+    """The T-37 of the docstring: its reference point 0.73 ft above the c.g. (b 33.83 ft), C_Y,β
+    −0.25 withheld because the force mismatch cannot tell it from the accelerometer's position
+    (``sensor_rival``): the C_l,β −0.0054 its arm makes is not named in its place. A force
+    term withheld for another reason explains nothing."""
+    rng = np.random.default_rng(5)
+    dt, n = 0.04, 750
+    t = np.arange(n) * dt
+    beta = 0.02 * np.sin(2 * np.pi * 0.3 * t) + 0.01 * np.sin(2 * np.pi * 0.9 * t)
+    p = SimpleNamespace(n=n, dt=dt, smooth={"alpha": np.full(n, 0.05)},
+                        meta={"geometry": {"b_ft": 33.83, "cbar_ft": 5.47}})
+    trim = SimpleNamespace(aero_rp_in=(0.0, 0.0, 0.0), cg_in=(0.0, 0.0, -8.8))
+    roll = -reference_arm_ft(trim)[1] * (-0.25 * beta) / 33.83
+    for details, kept in (({"sensor_rival": "x_accelerometer"}, False), ({}, True)):
+        cy_sel, cy = _stepwise("CY", "beta", "CY_beta", beta, -0.25)
+        cy.selected, cy.details = False, dict(details)
+        cl_sel, cl = _stepwise("Cl", "beta", "Cl_beta", beta, -0.0054)
+        mismatch = {"CY": -0.25 * beta, "Cl": roll + rng.normal(scale=1e-6, size=n)}
+        withhold_explained_by_force_arm([cy, cl], {"CY": cy_sel, "Cl": cl_sel}, mismatch, p, trim)
+        assert cl.selected is kept
+        if not kept:
+            assert "unnamed beside the accelerometer's position" in cl.reason
+
+
 def test_a_kinematic_rival_is_sized_in_the_place_of_the_term_it_contests():
     """Two nearly collinear kinematic columns (r ≈ 0.97): the record follows the rival's. Beside
     the selected term the rival's estimate is whatever the two share out; in its place it is
@@ -100,3 +124,39 @@ def test_the_positions_rival_is_not_named_where_neither_stands_beside_the_other(
     standing = cands(-7.2)
     withhold_the_positions_rival(standing)
     assert standing[1].selected
+
+
+def test_two_sensor_errors_the_kinematics_cannot_tell_apart_are_not_both_named_on_corroboration():
+    """Two corroborated suspects on nearly collinear kinematic columns (r ≈ 0.97), the record
+    following their sum's share: each alone stands, together neither reaches AMBIGUOUS_T, and
+    neither is named. Where the record follows one column's own part, that one stays."""
+    from harness.diagnosis.sensor_naming import withhold_corroborated_rivals
+    from harness.diagnosis.sensor_rules import AMBIGUOUS_T, kinematic_t_beside
+
+    rng = np.random.default_rng(6)
+    n = 2500
+    a = np.sin(np.linspace(0.0, 40.0, n))
+    b = a + 0.25 * np.sin(np.linspace(0.0, 23.0, n))
+    noise = rng.normal(size=n)
+
+    def named():
+        return [Candidate("sensor_skew", None, "az", "skew_az", -0.06, 0.01, -6.0, 0.1, "s", "kinematic consistency",
+                          True, "named on two independent tests"),
+                Candidate("sensor_offset", None, "accelerometer", "offset_x", 3.5, 0.5, 7.0, 0.1, "ft",
+                          "kinematic consistency", True, "named on two independent tests")]
+    kin = SimpleNamespace(columns={"skew_az": a, "offset_x": b}, forced=(), selection=SimpleNamespace(names=()))
+    kin.start = 0.01 * (a + b) + 0.08 * noise
+    alone = [kinematic_t_beside(kin, x)[x] for x in ("skew_az", "offset_x")]
+    together = kinematic_t_beside(kin, ("skew_az", "offset_x"))
+    assert min(alone) >= AMBIGUOUS_T and max(together.values()) < AMBIGUOUS_T, (alone, together)
+    cands = named()
+    withhold_corroborated_rivals(cands, kin)
+    assert not any(c.selected for c in cands)
+    assert "cannot tell it from offset_x" in cands[0].reason
+    kin.start = 0.05 * (b - a) + 0.08 * noise  # the offset's own part: it stands beside the skew
+    cands = named()
+    withhold_corroborated_rivals(cands, kin)
+    assert cands[1].selected
+    cands = named()[:1]  # one alone is left as it was
+    withhold_corroborated_rivals(cands, kin)
+    assert cands[0].selected
