@@ -37,19 +37,24 @@ def _stepwise(axis: str, key: str, parameter: str, column: np.ndarray, change: f
     return (sel, {key: term}), cand
 
 
+def _side_force_roll(dt: float, n: int, b_ft: float, cbar_ft: float, trim):
+    """A recording stand-in with a two-sine β, and the roll a C_Y,β change of −0.25 acting at
+    the trim's reference point makes about the c.g."""
+    t = np.arange(n) * dt
+    beta = 0.02 * np.sin(2 * np.pi * 0.3 * t) + 0.01 * np.sin(2 * np.pi * 0.9 * t)
+    p = SimpleNamespace(n=n, dt=dt, smooth={"alpha": np.full(n, 0.05)},
+                        meta={"geometry": {"b_ft": b_ft, "cbar_ft": cbar_ft}})
+    return p, beta, -reference_arm_ft(trim)[1] * (-0.25 * beta) / b_ft
+
+
 def test_a_roll_the_side_force_change_makes_about_the_cg_is_not_a_cl_change():
     """A C_Y,β change of −0.25 acting 5.3 ft above the c.g. (b 94.7 ft) rolls by +0.056 ΔC_Y:
     a C_l,β 'change' of −0.014 in the mismatch is its moment and is withheld; a C_l,β change of
     −0.03 on top of it stays."""
     rng = np.random.default_rng(1)
-    dt, n = 0.02, 1500
-    t = np.arange(n) * dt
-    beta = 0.02 * np.sin(2 * np.pi * 0.3 * t) + 0.01 * np.sin(2 * np.pi * 0.9 * t)
-    p = SimpleNamespace(n=n, dt=dt, smooth={"alpha": np.full(n, 0.05)},
-                        meta={"geometry": {"b_ft": 94.7, "cbar_ft": 11.0}})
     trim = SimpleNamespace(aero_rp_in=(625.0, 0.0, 24.0), cg_in=(639.0, 0.0, -40.0))
-    arm = reference_arm_ft(trim)
-    roll = -arm[1] * (-0.25 * beta) / 94.7
+    p, beta, roll = _side_force_roll(0.02, 1500, 94.7, 11.0, trim)
+    n = p.n
     for extra, kept in ((0.0, False), (-0.03, True)):
         cy_sel, cy = _stepwise("CY", "beta", "CY_beta", beta, -0.25)
         cl_sel, cl = _stepwise("Cl", "beta", "Cl_beta", beta, -0.014 + extra)
@@ -66,13 +71,9 @@ def test_a_force_change_left_unnamed_beside_the_accelerometer_still_explains_its
     (``sensor_rival``): the C_l,β −0.0054 its arm makes is not named in its place. A force
     term withheld for another reason explains nothing."""
     rng = np.random.default_rng(5)
-    dt, n = 0.04, 750
-    t = np.arange(n) * dt
-    beta = 0.02 * np.sin(2 * np.pi * 0.3 * t) + 0.01 * np.sin(2 * np.pi * 0.9 * t)
-    p = SimpleNamespace(n=n, dt=dt, smooth={"alpha": np.full(n, 0.05)},
-                        meta={"geometry": {"b_ft": 33.83, "cbar_ft": 5.47}})
     trim = SimpleNamespace(aero_rp_in=(0.0, 0.0, 0.0), cg_in=(0.0, 0.0, -8.8))
-    roll = -reference_arm_ft(trim)[1] * (-0.25 * beta) / 33.83
+    p, beta, roll = _side_force_roll(0.04, 750, 33.83, 5.47, trim)
+    n = p.n
     for details, kept in (({"sensor_rival": "x_accelerometer"}, False), ({}, True)):
         cy_sel, cy = _stepwise("CY", "beta", "CY_beta", beta, -0.25)
         cy.selected, cy.details = False, dict(details)
