@@ -161,3 +161,20 @@ def test_two_sensor_errors_the_kinematics_cannot_tell_apart_are_not_both_named_o
     cands = named()[:1]  # one alone is left as it was
     withhold_corroborated_rivals(cands, kin)
     assert cands[0].selected
+
+
+def test_an_accelerometer_position_from_the_force_mismatch_does_not_correct_the_channels():
+    """The force mismatch's accelerometer position is named without a kinematic parameter: the
+    delay-imitation test (which corrects the channels for a named sensor error and scans
+    again) passes over it instead of failing, and the delay stays (a probe's F-15 with a 60 ms
+    stabilator delay had both selected)."""
+    from harness.diagnosis.sensor_naming import withhold_delays_imitated_by_named
+
+    position = Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", 3.6, 0.7, 5.3, 0.1, "ft",
+                         "force mismatch on ω̇×r + ω×(ω×r)", True, "significant and practical")
+    delay = Candidate("control_delay", "pitch", "de", "tau_de", 0.044, 0.001, 38.0, 0.2, "s",
+                      "delay scan of de + stepwise", True, "entered")
+    kin = SimpleNamespace(parameters={}, columns={}, forced=(), selection=SimpleNamespace(names=(), params={},
+                                                                                          terms=()))
+    withhold_delays_imitated_by_named([position, delay], kin, None, None, None, {}, {}, set())
+    assert delay.selected and position.selected

@@ -440,7 +440,9 @@ def withhold_delays_imitated_by_named(cands: list[Candidate], kin: KinematicResu
     for sensor in named:
         if not delays:
             return
-        members = unit_members(kin, sensor.parameter)
+        members = [m for m in unit_members(kin, sensor.parameter) if m in kin.parameters]
+        if not members:  # an error the channels cannot be corrected for (the force mismatch's accelerometer)
+            continue
         corrected = corrected_recording(p, kin, {m: sensor.estimate for m in members})
         mismatch = model_along(corrected, aircraft, ic, inertial_from=p).mismatch()
         for c in list(delays):
