@@ -523,8 +523,12 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
         rival, refuted = ask(rivals.TERM_RIVAL_CORRELATION)
         if rival is not None and abs(rival.correlation) < rivals.RIVAL_CORRELATION and abs(rival.t_term) >= cand.T_IN:
             # below the collinearity limit a rival is asked only whether the identification can
-            # tell the term from it; where it can, the collinear rivals are judged as before
+            # tell the term from it; where it can, the collinear rivals are judged as before, and
+            # without one the validation maneuver still judges this rival (set apart here)
+            looser = (rival, refuted)
             rival, refuted = ask(rivals.RIVAL_CORRELATION)
+            if rival is None:
+                rival, refuted = looser
         if refuted and abs(refuted[0].correlation) >= rivals.RIVAL_CORRELATION:
             # the term then rests on its own t (validation.unreplicated) only where the two
             # columns are collinear (the seed's limit); below it its estimate stands apart and the

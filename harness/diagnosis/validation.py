@@ -103,10 +103,32 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
         elif rival["indistinct"] and out["status"] == "confirmed":
             out["reason"] = f"{rival['indistinct']}; the validation maneuver prefers it"
     if out["status"] == "confirmed":
-        why = unreplicated(av, f)
+        why = unreplicated(av, f) or rival_entered_instead(av, f)
         if why:
             out["status"], out["reason"] = "ambiguous", why
     return out
+
+
+def rival_entered_instead(av: Analysis, f: Candidate) -> str:
+    """Why a finding is not named whose collinear rival (``details['rival']``, :mod:`rivals`)
+    the validation maneuver's own fit selects in its place ('' otherwise): the two maneuvers
+    then disagree on which of the pair carries the mismatch, and the identification's choice
+    is one maneuver's word against the other's. Asked of every rival kept, also one the
+    identification set apart (correlated under the collinearity limit, the term standing
+    beside it). A probe's F-15 (641 ft/s, three-axis 3-2-1-1 at 25 Hz) with C_m,α̇ −3 had
+    C_m,q̂ −3.2 named (t −28; α̇ beside it t 1.7, the columns correlated 0.88), its validation
+    RMS 43 % lower; the validation maneuver's own fit entered C_m,α̇ (t 14 beside q̂), and
+    noise-free the identification had entered both."""
+    r = f.details.get("rival")
+    if not r:
+        return ""
+    own = next((c for c in av.candidates if c.channel == f.channel and c.parameter == f.parameter), None)
+    theirs = next((c for c in av.candidates if c.channel == r["axis"] and c.parameter == r["parameter"]), None)
+    if theirs is None or not theirs.selected or (own is not None and own.selected):
+        return ""
+    return (f"the validation maneuver's own fit enters {r['parameter']} (t = {theirs.t:.1f}) in its place, its rival "
+            f"in the identification fit (columns correlated {r['correlation']:+.2f}; beside it, t = "
+            f"{r['t_term']:.1f}): the maneuvers disagree on which of the two carries the mismatch")
 
 
 # A finding's prediction must stand in the validation maneuver's mismatch at this many
