@@ -7,6 +7,7 @@ import numpy as np
 from scipy.stats import linregress
 
 from harness.diagnosis.along import ModelAlong, model_along, slope_function
+from harness.diagnosis.candidates import VANE_ALPHA_RATE_AXES
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import kinematic_residuals
 from harness.diagnosis.prepare import Prepared, interior_slice
@@ -181,11 +182,17 @@ def withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:
     """In gusts too light to name (:func:`light_gusts`) the coefficient terms stand (a C_m,q̂
     change is still named at Dryden severity 2), but not the accelerometer position fitted to
     the force mismatch: the gust's pitching part follows q̇ there (a DHC-6 null named an
-    accelerometer 15 ft aft, t = 25)."""
+    accelerometer 15 ft aft, t = 25); nor an α̇ term whose column is the inertial α̇
+    (:data:`candidates.VANE_ALPHA_RATE_AXES` lists the axes built on the vane's instead): the
+    aerodynamics see the air's α̇, which adds the gust's own rate ẇ_g/V, and the airframe's
+    inertial α̇ answers that gust. A probe's J3 Cub (106 ft/s, pitch multisine) in gusts of
+    2.8 ft/s (1.45° of angle) had C_m,α̇ +5.8 named (t 6.8) beside the light turbulence."""
     for c in cands:
-        if c.selected and c.parameter == "x_accelerometer":
+        inertial_rate = c.effect == "unsteady_alphadot" and c.channel not in VANE_ALPHA_RATE_AXES
+        if c.selected and (c.parameter == "x_accelerometer" or (inertial_rate and c.test.startswith("stepwise"))):
             c.selected = False
-            c.reason = f"not named: {why}"
+            c.reason = (f"not named: its α̇ is the inertial one (gyros and accelerometers), which lacks the gust's own "
+                        f"rate ẇ_g/V that the aerodynamics see ({why})") if inertial_rate else f"not named: {why}"
 
 
 def mode_candidate(peak, selected: bool, reason: str) -> Candidate:
