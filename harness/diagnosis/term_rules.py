@@ -521,14 +521,17 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
             rest = [k for k in pool if k != first.key]
             return rivals.strongest_rival(z, columns, key, others, rest, min_correlation=gate), (first, refuted)
         rival, refuted = ask(rivals.TERM_RIVAL_CORRELATION)
+        set_apart = False
         if rival is not None and abs(rival.correlation) < rivals.RIVAL_CORRELATION and abs(rival.t_term) >= cand.T_IN:
             # below the collinearity limit a rival is asked only whether the identification can
             # tell the term from it; where it can, the collinear rivals are judged as before, and
-            # without one the validation maneuver still judges this rival (set apart here)
+            # without one this rival is kept only for the validation maneuver's own fit to judge
+            # (validation.rival_entered_instead), not its RMS
             looser = (rival, refuted)
             rival, refuted = ask(rivals.RIVAL_CORRELATION)
             if rival is None:
                 rival, refuted = looser
+                set_apart = True
         if refuted and abs(refuted[0].correlation) >= rivals.RIVAL_CORRELATION:
             # the term then rests on its own t (validation.unreplicated) only where the two
             # columns are collinear (the seed's limit); below it its estimate stands apart and the
@@ -541,7 +544,8 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
             rt = by_key[rival.key]
             c.details["rival"] = {"parameter": rt.parameter, "effect": rt.effect, "axis": c.channel,
                                   "correlation": rival.correlation, "t_term": rival.t_term,
-                                  "t_rival": rival.t_rival, "coefficient": rival.swapped}
+                                  "t_rival": rival.t_rival, "coefficient": rival.swapped,
+                                  "under_collinearity": set_apart}
             apart = _shift_set_apart(c, p, selections, nuisances, mismatch, measured)
             if apart:
                 c.details["rival"]["set_apart"] = apart

@@ -92,6 +92,7 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
     rival = _rival_check(av, f, axes, after, ratio - 1.0)
     if rival is not None:
         out["rival"] = rival
+    if rival is not None and not f.details["rival"].get("under_collinearity"):  # those: rival_entered_instead
         if out["status"] == "confirmed" and rival["fits_as_well"] and not rival["joint_prefers_it"]:
             out["status"] = "ambiguous"
             out["reason"] = _ambiguous_reason(rival, ratio - 1.0)
