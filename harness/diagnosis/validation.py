@@ -117,9 +117,9 @@ def rival_entered_instead(av: Analysis, f: Candidate) -> str:
     is one maneuver's word against the other's. Asked of every rival kept, also one the
     identification set apart (correlated under the collinearity limit, the term standing
     beside it). A probe's F-15 (641 ft/s, three-axis 3-2-1-1 at 25 Hz) with C_m,α̇ −3 had
-    C_m,q̂ −3.2 named (t −28; α̇ beside it t 1.7, the columns correlated 0.88), its validation
-    RMS 43 % lower; the validation maneuver's own fit entered C_m,α̇ (t 14 beside q̂), and
-    noise-free the identification had entered both."""
+    C_m,q̂ −3.2 named (t −28; −6.8 beside C_m,α̇, which stood at 1.7 beside it, the columns
+    correlated 0.88), its validation RMS 43 % lower; the validation maneuver's own fit entered
+    C_m,α̇ (t −18) and not C_m,q̂, and noise-free the identification had entered both."""
     r = f.details.get("rival")
     if not r:
         return ""
