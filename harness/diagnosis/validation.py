@@ -90,9 +90,11 @@ def validation_check(av: Analysis, f: Candidate) -> dict | None:
                          "lowers the RMS by chance as much as by the term") if prediction["t"] is not None else \
             "the validation maneuver's mismatch cannot be fitted on the predicted term"
     rival = _rival_check(av, f, axes, after, ratio - 1.0)
+    set_apart = rival is not None and f.details["rival"].get("under_collinearity", False)
     if rival is not None:
-        out["rival"] = rival
-    if rival is not None and not f.details["rival"].get("under_collinearity"):  # those: rival_entered_instead
+        # a rival the identification set apart is recorded, not judged by these RMS (rival_entered_instead)
+        out["rival"] = rival | {"under_collinearity": set_apart}
+    if rival is not None and not set_apart:
         if out["status"] == "confirmed" and rival["fits_as_well"] and not rival["joint_prefers_it"]:
             out["status"] = "ambiguous"
             out["reason"] = _ambiguous_reason(rival, ratio - 1.0)
