@@ -288,3 +288,27 @@ def test_one_axis_needs_the_kinematics_at_three_standard_errors():
     assert not v.named and "only Cm shows it" in v.reason
     assert corroborate("scale_q", 0.0344, 0.0344 / ONE_AXIS_KINEMATIC_T, {"Cm": cm}, t_aero=5.0).named
     assert one_axis_and_a_weak_suspicion((cm, AxisRatio("CZ", 1.0, 0.3)), 2.5) == ""
+
+
+def test_an_own_term_under_the_rival_correlation_is_still_fitted_beside_the_signature():
+    """corroborate.axis_ratio fits the axis's most collinear own term beside the signature
+    whatever their correlation: a probe's F-4N with C_Z,α 0.5 higher (pitch multisine,
+    100 Hz) had its accelerometer named 5.1 ft aft on C_Z and C_m, C_Z's signature correlated
+    with C_Z,α at r 0.697, under the 0.7 gate that fit once had, so C_Z counted as showing
+    the error though beside C_Z,α it stood at t −0.2. Constructed: the mismatch is the term's
+    change and noise, the signature shares r = 0.69 with the term."""
+    from harness.diagnosis.corroborate import explained_by_own_term
+    rng = np.random.default_rng(4)
+    t = np.linspace(0.0, 30.0, 3001)
+    term = np.sin(1.3 * t)
+    other = np.sin(2.1 * t + 0.4)
+    other -= term * np.dot(other, term) / np.dot(term, term)
+    unit = lambda x: (x - x.mean()) / np.std(x)
+    signature = 0.69 * unit(term) + np.sqrt(1.0 - 0.69 ** 2) * unit(other)
+    z = 0.5 * term + 0.05 * rng.normal(size=t.size)
+    r = axis_ratio(z, [], signature, offered={"CZ_alpha": term}, excursion=float(np.std(z)))
+    assert r.imitator == "CZ_alpha" and r.imitator_r == pytest.approx(0.69, abs=0.01)
+    assert abs(r.ratio) / r.std_error > 2.0                 # alone, the signature "shows" the error
+    t_signature, t_term = r.beside_imitator
+    assert abs(t_signature) < 2.0 and abs(t_term) > 10.0
+    assert explained_by_own_term(r)

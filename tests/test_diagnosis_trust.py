@@ -679,7 +679,8 @@ def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the
     """stepwise_axes.vane_noise_columns: the column −C_m,α·e (e = −w_gust/V from the kinematic
     residual) is offered to C_m's fit when, fitted alone, it takes at least VANE_NOISE_SHARE
     off the mismatch RMS (a mismatch that is mostly the vane's error passed through C_m,α),
-    not when the mismatch is something else, nor when α is held at its start."""
+    not when the mismatch is something else, nor when α is held at its start; C_X's column,
+    −∂C_X/∂α·e, always while α is followed."""
     from types import SimpleNamespace
 
     import numpy as np
@@ -692,14 +693,16 @@ def test_the_vane_noise_column_enters_cm_only_where_it_is_a_material_part_of_the
     p = SimpleNamespace(dt=0.02, n=n)
     along = SimpleNamespace(states={"alpha": np.linspace(0.0, 0.02, n)})
     slope = np.full(n, -1.2)
+    cx_slope = 0.3 + 14.5 * np.linspace(-0.02, 0.02, n)  # a drag polar's: C_X,α + C_X''·Δα
+    slopes = lambda x: {"Cm": slope, "CX": cx_slope}
     column = slope * w / V0                            # −C_m,α·e with e = −w/V
     vane_made = {"Cm": 0.9 * column + 0.3 * np.std(column) * rng.standard_normal(n)}
     other = {"Cm": np.std(column) * rng.standard_normal(n)}
-    got = stepwise_axes.vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, vane_made)
-    assert set(got) == {"Cm"} and np.allclose(got["Cm"], column)
-    assert stepwise_axes.vane_noise_columns(p, along, lambda x: {"Cm": slope}, V0, other) == {}
+    got = stepwise_axes.vane_noise_columns(p, along, slopes, V0, vane_made)
+    assert set(got) == {"Cm", "CX"} and np.allclose(got["Cm"], column) and np.allclose(got["CX"], cx_slope * w / V0)
+    assert set(stepwise_axes.vane_noise_columns(p, along, slopes, V0, other)) == {"CX"}
     held = SimpleNamespace(states={"alpha": np.zeros(n)})
-    assert stepwise_axes.vane_noise_columns(p, held, lambda x: {"Cm": slope}, V0, vane_made) == {}
+    assert stepwise_axes.vane_noise_columns(p, held, slopes, V0, vane_made) == {}
 
 
 def test_a_moment_reference_shift_is_refuted_by_a_mistrim_the_recording_lacks():
@@ -1502,15 +1505,14 @@ def test_a_beta_derivative_says_an_untested_coupling_would_read_as_it(monkeypatc
     assert "not_ruled_out" not in alone.details
 
 
-def test_the_inertial_sideslip_gets_the_common_filter_like_every_other_state(monkeypatch):
-    """along.model_states: the measured coefficients and every other state pass through the
-    recording's common filter, so the inertial sideslip the model follows must too (the
-    equation holds between quantities of one bandwidth). Unfiltered, on an F-16 lateral
-    maneuver at 3,000 ft / 260 ft/s (α 11°, common cut-off 0.3-0.7 Hz, where the Dutch roll
-    is), the C_l mismatch followed β at +0.030 per rad where C_l,β was 0.03 low (true
-    change −0.03): the model's full-bandwidth β against the filtered C_l. Here a stand-in
-    filter halves every record and the inertial angle is a 0.6 Hz sine: the state is the
-    halved sine, as the smoothed vane is."""
+def test_the_model_follows_the_unfiltered_states_and_the_inertial_sideslip(monkeypatch):
+    """along.model_states: the model is evaluated along the recorded states as they are,
+    unfiltered, the driven sideslip the inertial one (also unfiltered), the undriven rates
+    held at their start and the airspeed its own smoothing; its coefficients then pass
+    through the common filter (along.filtered), as the measured ones did. (Until 4 Dec 2026
+    the inertial angle kept its channels' own bandwidth while the vane states were filtered:
+    on an F-16 lateral maneuver at 3,000 ft / 260 ft/s, common cut-off 0.3-0.7 Hz, the C_l
+    mismatch followed β at +0.030 per rad where C_l,β was 0.03 low.)"""
     from types import SimpleNamespace
 
     from harness.diagnosis import along
@@ -1518,15 +1520,17 @@ def test_the_inertial_sideslip_gets_the_common_filter_like_every_other_state(mon
     t = np.arange(n) * dt
     sine = 0.01 * np.sin(2 * np.pi * 0.6 * t)
     ones = np.ones(n)
-    raw = {c: ones.copy() for c in along.INERTIAL_CHANNELS}
-    p = SimpleNamespace(smooth={k: 0.5 * raw[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta")},
-                        driven=("beta", "p", "r"), moved=(), start={k: 0.5 for k in raw}, n=n, raw=raw, own_noise={},
+    raw = {c: ones.copy() for c in along.INERTIAL_CHANNELS} | {"de": 0.02 * ones}
+    p = SimpleNamespace(smooth={k: 0.5 * raw[k] for k in raw}, driven=("beta", "p", "r"), moved=(),
+                        start={k: 0.25 for k in raw}, n=n, raw=raw, own_noise={"V": 0.1 * ones},
                         altitude=None, filt=lambda x: 0.5 * np.asarray(x))
     monkeypatch.setattr(along, "inertial_angles", lambda ch, src: {"alpha": ones, "beta": sine})
-    states, _ = along.model_states(p)
-    assert np.allclose(states["beta"], 0.5 * sine, rtol=0, atol=1e-15)
-    # the vane's own sideslip (vane_beta) stays the smoothed record
-    assert np.array_equal(along.model_states(p, vane_beta=True)[0]["beta"], p.smooth["beta"])
+    states, surfaces = along.model_states(p)
+    assert np.array_equal(states["beta"], sine) and np.array_equal(states["p"], raw["p"])
+    assert np.array_equal(states["q"], np.full(n, 0.25)) and np.allclose(states["V"], 0.9)
+    assert np.array_equal(surfaces["de"], raw["de"])
+    # the vane's own sideslip (vane_beta) is the recorded one
+    assert np.array_equal(along.model_states(p, vane_beta=True)[0]["beta"], raw["beta"])
 
 
 def test_the_smallest_delay_named_is_a_time_and_at_least_one_and_a_half_samples():
@@ -1862,25 +1866,35 @@ def test_an_alpha_square_must_hold_inside_the_maneuver_window_of_a_long_record(s
     assert maneuver_window(p) is None
 
 
-def test_the_model_is_limited_to_the_common_filter_band_so_a_square_adds_no_mismatch():
-    """band_limit keeps every sine coefficient the common filter passes and drops the rest: a
-    record built of sines below the cut-off passes exactly, the square of a 0.8 Hz sine (its
-    2·0.8 = 1.6 Hz part above a 1.1 Hz cut-off) keeps only its mean. So C = α² of a filtered
-    α, band-limited, is what the filter leaves of the true α²."""
-    from types import SimpleNamespace
+def test_the_model_goes_through_the_common_filter_after_its_nonlinear_terms():
+    """along.filtered: the model's coefficients along the raw states, through the common
+    filter, are the measured side's own operation (the filter of what the aerodynamics did),
+    so a drag polar's α² leaves no mismatch; the model of the filtered α leaves the power the
+    filter removed, filt(α²) − filt(α)², which an α² column fits (the c172x's C_X α² of the
+    along.model_states docstring)."""
     from estimators.smoothing import sine_series_filter
-    from harness.diagnosis.along import band_limit
+    from harness.diagnosis.along import filtered
+    from models.replay import AeroAlong
     n, dt = 2001, 0.02
     t = np.arange(n) * dt
     freqs = np.arange(1, n - 1) / (2 * (n - 1) * dt)        # sine-series frequencies, Hz
-    weights = np.clip((1.1 - freqs) / 0.3, 0.0, 1.0)         # a Wiener-like taper ending at 1.1 Hz
-    band = band_limit(SimpleNamespace(weights=weights))
-    assert set(np.unique(band)) == {0.0, 1.0} and np.all((band == 1.0) == (weights > 1e-6))
-    low = np.sin(np.pi * 40 * t / t[-1]) + 0.5 * np.sin(np.pi * 70 * t / t[-1])  # 0.5 and 0.875 Hz, exact sine terms
-    assert np.allclose(sine_series_filter(low, band), low, atol=1e-9)
-    alpha = 0.02 * np.sin(np.pi * 64 * t / t[-1])                               # 0.8 Hz
-    square = sine_series_filter(alpha ** 2, band)            # 0.0002 (1 - cos 2wt): its 1.6 Hz part goes
-    constant = sine_series_filter(np.full(n, 2e-4), band)
-    inner = (t > 5.0) & (t < t[-1] - 5.0)                   # clear of the series' end effects
-    assert np.max(np.abs(square - constant)[inner]) < 0.05 * 2e-4
-    assert np.max(np.abs(alpha ** 2 - constant)[inner]) > 0.9 * 2e-4  # unfiltered, the 1.6 Hz part is all there
+    weights = np.clip((1.1 - freqs) / 0.6, 0.0, 1.0)         # a Wiener-like taper from 0.5 to 1.1 Hz
+    rng = np.random.default_rng(5)
+    # a pitch maneuver's α about trim: content in and beyond the taper (0.3-2 Hz), 1.3° RMS
+    alpha = 0.03 + sum(a * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+                       for a, f in ((0.015, 0.3), (0.01, 0.7), (0.008, 1.0), (0.006, 1.5), (0.004, 2.0)))
+    k = 7.0                                                  # the polar's curvature, per rad²
+    measured = sine_series_filter(k * alpha ** 2, weights)   # Eq. 1 on filtered accelerations
+    from types import SimpleNamespace
+    trim = SimpleNamespace(thrust_lbf=0.0)
+    model = filtered(AeroAlong({"CX": k * alpha ** 2}, {}, {}, trim), weights).coefficients["CX"]
+    assert np.allclose(model, measured, atol=1e-12)
+    old = k * sine_series_filter(alpha, weights) ** 2       # the model of the filtered α
+    inner = slice(250, n - 250)
+    da = sine_series_filter(alpha, weights)[inner] - 0.03
+    A = np.column_stack([np.ones(da.size), da, da ** 2])
+    fit = lambda z: np.linalg.lstsq(A, z[inner], rcond=None)[0][2]
+    assert abs(fit(measured - model)) < 1e-9
+    assert fit(measured - old) < -0.05 * k                   # the artifact the old order left (-14 % of k)
+
+

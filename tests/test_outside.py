@@ -600,14 +600,18 @@ def test_an_alphadot_the_gyros_time_skew_imitates_is_not_named(tmp_path, seed, r
 def test_a_power_of_alpha_on_the_integration_drift_is_not_named(tmp_path):
     """An independent c172x null (seed 4, 100 Hz): beside the α vane's error column a C_m α²
     of 3.3 entered at t 5.4; with the column's slowest part (the inertial integration's drift)
-    high-passed away it is t 1.8 (term_rules.withhold_off_the_integration_drift): none."""
+    high-passed away it is t 1.8 (term_rules.withhold_off_the_integration_drift): none. Since
+    the model goes through the common filter after its nonlinear terms (thirty-sixth session)
+    it stands at t 4.4 and does not enter (the rule stays pinned by the drift term's test
+    above)."""
     from harness.diagnosis.run import diagnose
     path = tmp_path / "c172x.csv"
     independent_c172x_recording(path, 4)
     result = diagnose("c172x", path, tmp_path / "out", calibrate=False)
     assert [f["effect"] for f in result["findings"]] == ["none"]
     power = next(c for c in result["candidates"] if c["parameter"] == "Cm_alpha2")
-    assert abs(power["t"]) >= 5.0 and not power["selected"] and "integration's own drift" in power["reason"]
+    assert not power["selected"]
+    assert abs(power["t"]) < 5.0 or "integration's own drift" in power["reason"], power["reason"]
 
 
 @pytest.mark.parametrize("factor", [1.2, 0.5])

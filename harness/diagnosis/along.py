@@ -12,7 +12,7 @@ import numpy as np
 from estimators.smoothing import sine_series_filter
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles
+from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles, kinematic_alpha_rate
 from harness.diagnosis.prepare import (COEFFICIENTS, DRIVEN_BY, Prepared, clean_channels, interior_slice,
                                        measured_coefficients)
 from models.aircraft import Aircraft
@@ -48,7 +48,22 @@ def rate_derivatives_advanced(p: Prepared, tau: float) -> Prepared:
 
 def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: bool = False,
                  vanes: bool = False) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """The states and surfaces the model is evaluated along.
+    """The states and surfaces the model is evaluated along: the recorded ones, unfiltered;
+    the model's coefficients then go through the common filter (:func:`model_along`).
+
+    The measured coefficients are Eqs. 1-5 on the filtered channels: the filter applied to
+    what the aerodynamics did along the true states. The model must see the same operator in
+    the same place. Evaluated along filtered states, a nonlinear model is not the filter of
+    itself: filt(α²) − filt(α)² is the power the filter removed from α, and a drag polar's
+    α² turned it into a C_X mismatch that an α² column fits (a noise-free c172x 3-2-1-1 at
+    173 ft/s, C_X α² −0.16 at the recording's own 14.6 Hz cut-off, −0.6 at the 1.8 Hz that
+    white gyro noise set; probe 71's 90 s c172x multisine at 1.1 Hz, −2.4 at t −6.9, had its
+    sum frequencies limited away by a band of ones until 7 Dec 2026). Along the raw states and
+    filtered after, both sides are the same filter of the same functions; a linear model's
+    mismatch is what it was (the filter of a linear function of the raw states is that
+    function of the filtered states), and noise reaches a nonlinear term only as its square
+    (a constant, in the bias) and a product with the state, which the filter takes as it takes
+    the noise of the linear terms.
 
     A state the maneuver did not drive is held at its start: evaluated along its noise, the
     model would pass that noise on through its derivative (errors in variables), and the
@@ -61,17 +76,17 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: 
     model's coefficients (through q̂ = qc̄/2V, dynamic pressure and Mach-scheduled terms).
 
     A driven sideslip is the inertial one (:func:`kinematics.inertial_angles`: the v̇ equation
-    integrated from a_y, the rates and attitude, placed on the vane by a constant and trend,
-    then passed through the common filter as every other state and the measured coefficients
-    are: at a low common cut-off, 0.3-0.7 Hz on a slow F-16 at α 11°, the unfiltered angle's
-    Dutch roll against the filtered C_l turned a C_l,β change of −0.03 into +0.03):
+    integrated from a_y, the rates and attitude, placed on the vane by a constant and trend;
+    the model's coefficients along it pass through the common filter as the measured ones do:
+    at a low common cut-off, 0.3-0.7 Hz on a slow F-16 at α 11°, an unfiltered angle's Dutch
+    roll against the filtered C_l turned a C_l,β change of −0.03 into +0.03):
     a vane's slow wander survives any smoother and reaches the mismatch through C_n,β, C_l,β
     and C_Y,β, where it buried the outside sweep's lateral coefficient errors (C_l,β −0.02,
     C_n,β +0.03, C_n,r̂ −0.3, C_l,p̂ −0.1 at |t| 1.6–4.7; 5.9–22 along the inertial β). A β-vane
     scale then leaves the mismatch alone; the kinematic check names it. With ``vane_beta``
-    the sideslip is the vane's; with ``vanes`` α and β are both the vanes' own smoothed
-    records, driven or not (the vane-bias tests on the coefficient means)."""
-    states = {k: p.smooth[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
+    the sideslip is the vane's; with ``vanes`` α and β are both the vanes' own records,
+    driven or not (the vane-bias tests on the coefficient means)."""
+    states = {k: p.raw[k] for k in ("V", "alpha", "beta", "p", "q", "r", "phi", "theta") if k in p.smooth}
     for k in ("alpha", "beta", "p", "q", "r"):
         if k in states and k not in p.driven and k not in p.moved and not (vanes and k in ("alpha", "beta")):
             states[k] = np.full(p.n, p.start[k])
@@ -80,8 +95,8 @@ def model_states(p: Prepared, inertial_from: Prepared | None = None, vane_beta: 
         src = inertial_from or p
         angles = inertial_angles(clean_channels(src, INERTIAL_CHANNELS), src)
         for k in inertial:
-            states[k] = p.filt(angles[k])
-    surfaces = {s: p.smooth[s] for s in SURFACES if s in p.smooth}
+            states[k] = angles[k]
+    surfaces = {s: p.raw[s] for s in SURFACES if s in p.smooth}
     if "V" in p.own_noise:
         states["V"] = p.raw["V"] - p.own_noise["V"]
     if p.altitude is not None:
@@ -97,30 +112,11 @@ class ModelAlong(NamedTuple):
     alphadot: np.ndarray | None
     aero: AeroAlong
     measured: dict[str, np.ndarray]
-    band: np.ndarray | None = None  # sine-series weights of the common filter's band (band_limit)
+    weights: np.ndarray  # the common filter the model's coefficients went through (sine-series weights)
 
     def mismatch(self) -> dict[str, np.ndarray]:
-        """Measured less model coefficients, the model's limited to the common filter's band
-        (:func:`band_limit`)."""
-        model = self.aero.coefficients
-        if self.band is not None:
-            model = {c: sine_series_filter(model[c], self.band) for c in COEFFICIENTS}
-        return {c: self.measured[c] - model[c] for c in COEFFICIENTS}
-
-
-def band_limit(p: Prepared) -> np.ndarray:
-    """The common filter's band as sine-series weights of 0 and 1: every coefficient the
-    common filter passes at all (weight over 1e-6) is kept whole, the rest removed.
-
-    The measured coefficients are Eqs. 1-5 on the filtered channels, so they hold nothing
-    above the common cut-off; the model, evaluated on the filtered states, holds nothing there
-    either while it is linear, but its quadratic terms (a drag polar's α², an |β|) carry the
-    sum frequencies of the maneuver's own, up to twice its band. Left in, they are a mismatch
-    of the opposite sign that an α² column fits (probe 71: a noise-free 90 s c172x pitch
-    multisine, 0.2-0.9 Hz, given white p and r noise that put the cut-off at 1.1 Hz, drew C_X α²
-    −2.4 at t −6.9). A band of ones below the cut-off leaves everything the states carry alone,
-    so a linear model's mismatch is untouched."""
-    return (p.weights > 1e-6).astype(float)
+        """Measured less model coefficients (both through the common filter)."""
+        return {c: self.measured[c] - self.aero.coefficients[c] for c in COEFFICIENTS}
 
 
 def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
@@ -129,10 +125,24 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
     (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
     sideslip with ``vane_beta``; both vanes' own records with ``vanes``)."""
     states, surfaces = model_states(p, inertial_from, vane_beta, vanes)
-    alphadot = cand.alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
-    aero = aero_along(aircraft, ic, states, surfaces, alphadot)
+    alphadot = model_alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
+    aero = filtered(aero_along(aircraft, ic, states, surfaces, alphadot), p.weights)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
-    return ModelAlong(states, surfaces, alphadot, aero, measured, band_limit(p))
+    return ModelAlong(states, surfaces, alphadot, aero, measured, p.weights)
+
+
+def filtered(aero: AeroAlong, weights: np.ndarray) -> AeroAlong:
+    """The model's coefficients through the common filter, as the measured ones are."""
+    return replace(aero, coefficients={c: sine_series_filter(x, weights) for c, x in aero.coefficients.items()})
+
+
+def model_alpha_rate(p: Prepared) -> np.ndarray:
+    """α̇ for the model's α̇ terms: the kinematic one from the recorded channels
+    (:func:`kinematics.kinematic_alpha_rate`; the common filter comes after the model), else
+    the α record's derivative through the common filter."""
+    if all(c in p.raw for c in cand.ALPHA_RATE_CHANNELS):
+        return kinematic_alpha_rate(p.raw)
+    return p.deriv["alpha"]
 
 
 # What the inertial sideslip is integrated from (kinematics.inertial_angles).
@@ -166,8 +176,10 @@ def interior(p: Prepared) -> slice:
 
 
 def slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, np.ndarray],
-                   surfaces: dict[str, np.ndarray], alphadot: np.ndarray | None, aero: AeroAlong):
-    """``slope_of(x)``: the model's ∂C/∂x along the states (:mod:`rivals`), evaluated on first
+                   surfaces: dict[str, np.ndarray], alphadot: np.ndarray | None, aero: AeroAlong,
+                   weights: np.ndarray):
+    """``slope_of(x)``: the model's ∂C/∂x along the states (:mod:`rivals`), through the common
+    filter ``weights`` as ``aero``'s coefficients are (:func:`model_along`), evaluated on first
     use and kept."""
     slopes: dict[str, dict[str, np.ndarray]] = {}
 
@@ -175,7 +187,7 @@ def slope_function(aircraft: Aircraft, ic: InitialCondition, states: dict[str, n
         if x not in slopes:
             shifted = dict(states)
             shifted[x] = np.asarray(states[x], dtype=float) + rivals.SLOPE_STEP_RAD
-            moved = aero_along(aircraft, ic, shifted, surfaces, alphadot)
+            moved = filtered(aero_along(aircraft, ic, shifted, surfaces, alphadot), weights)
             slopes[x] = {c: (moved.coefficients[c] - aero.coefficients[c]) / rivals.SLOPE_STEP_RAD
                          for c in COEFFICIENTS}
         return slopes[x]

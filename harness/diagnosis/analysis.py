@@ -103,7 +103,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     # 2. the model along the measured states
     recorded, (p, along, mismatch, refuted) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along[:5]
-    slope_of = slope_function(aircraft, ic, states, surfaces, alphadot, aero)
+    slope_of = slope_function(aircraft, ic, states, surfaces, alphadot, aero, along.weights)
     # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)
     near = near if not sensor_values else ""  # a corrected recording is not asked again
     air = air_share_test(p, aircraft, ic, along, slope_of, gust, V0) if turbulent or gusty or near else None

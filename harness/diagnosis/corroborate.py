@@ -42,7 +42,6 @@ from scipy.signal import correlate
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis.candidates import AMBIGUOUS_T, PRACTICAL_SHARE
-from harness.diagnosis.rivals import TERM_RIVAL_CORRELATION
 
 # An axis takes part when it determines the ratio to within ±100 % (one standard error).
 INFORMATIVE_SE = 1.0
@@ -144,7 +143,7 @@ def axis_ratio(z: np.ndarray, others: list[np.ndarray], signature: np.ndarray,
         mean, mean_se = float(theta0[-1]), float(se0[-1])
     imitator, r = most_collinear(signature, others, offered or {}, constant)
     share = abs(float(theta[j])) * float(np.std(signature)) / excursion if excursion > 0 else np.nan
-    beside = _beside(z, others, signature, offered[imitator], constant) if r >= RIVAL_R else (np.nan, np.nan)
+    beside = _beside(z, others, signature, offered[imitator], constant) if imitator else (np.nan, np.nan)
     return AxisRatio("", float(theta[j]), float(se[j]) if se[j] > 0 else np.inf, influence, residual, mean, mean_se,
                      float(np.mean(signature)), imitator, r, share, beside)
 
@@ -403,10 +402,15 @@ def imitated_by_own_terms(axes: tuple[AxisRatio, ...], t_kinematic: float = np.i
 
 
 def explained_by_own_term(a: AxisRatio) -> bool:
-    """Whether axis ``a``'s showing of the error is one of its own candidate terms, correlated
-    with the signature at :data:`RIVAL_R` or more: fitted together, the signature falls under
+    """Whether axis ``a``'s showing of the error is its own candidate term most collinear with
+    the signature, whatever their correlation: fitted together, the signature falls under
     :data:`SHOWING_T` while the term stays at :data:`candidates.AMBIGUOUS_T` (the data prefer
-    the term, as in the accelerometer position's rival test, ``candidates.offset_rival``)."""
+    the term, as in the accelerometer position's rival test, ``candidates.offset_rival``).
+    Until 7 Dec 2026 the pair was fitted only at r >= 0.7 (the rival test's gate,
+    :data:`rivals.TERM_RIVAL_CORRELATION`): a probe's F-4N with C_Z,α 0.5 higher (15,000 ft,
+    pitch multisine at 100 Hz) had its accelerometer named 5.1 ft aft on C_Z and C_m, C_Z's
+    signature at r 0.697 with C_Z,α and, beside it, at t −0.2. A correlation under the gate
+    only makes the pair easier to tell apart."""
     return abs(a.beside_imitator[0]) < SHOWING_T and abs(a.beside_imitator[1]) >= AMBIGUOUS_T
 
 
@@ -463,9 +467,6 @@ SHOWING_T = 2.0
 # ... and tells it from a change of one of its own terms when the signature's correlation
 # with each of them (beside the axis's named terms) stays under this.
 IMITATOR_R = 0.95
-# An own term this correlated with the signature is fitted beside it (:func:`explained_by_own_terms`):
-# the rival test's gate (:data:`rivals.TERM_RIVAL_CORRELATION`).
-RIVAL_R = TERM_RIVAL_CORRELATION
 
 
 def corroborate(name: str, kinematic: float, kinematic_std: float, ratios: dict[str, AxisRatio], *,

@@ -85,7 +85,8 @@ def air_share_test(p: Prepared, aircraft: Aircraft, ic: InitialCondition, along:
     vane_alpha = "alpha" in p.driven or "alpha" in p.moved
     if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0 or not vane_alpha:
         along = model_along(p, aircraft, ic, vanes=True)
-        slope_of = slope_function(aircraft, ic, along.states, along.surfaces, along.alphadot, along.aero)
+        slope_of = slope_function(aircraft, ic, along.states, along.surfaces, along.alphadot, along.aero,
+                                  along.weights)
     slope = slope_of("alpha")["CZ"]
     # an angle the maneuver neither drove nor moved is its vane's noise and wander, the very
     # error the test asks after: as a nuisance it took the vane error's place (an independent

@@ -92,12 +92,13 @@ def vane_error_column(slope_of, gust, V0: float, axis: str) -> np.ndarray:
 
 def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mismatch: dict[str, np.ndarray],
                        gust=None) -> dict[str, np.ndarray]:
-    """The column −C_m,α·e that the α vane's own error passes into C_m's mismatch, e the
-    vane's angle less the one the inertial channels integrate to (the kinematic residual's
-    vertical "gust" over the airspeed, high-passed at :data:`spectra.GUST_HIGHPASS_HZ`); empty
-    when the model is not evaluated along the vane (α held at its start) or when the column
-    takes less than :data:`VANE_NOISE_SHARE` off C_m's mismatch RMS. ``gust`` is the gust
-    estimate already made from these channels; None makes it again (after sensor corrections).
+    """The columns −∂C/∂α·e that the α vane's own error passes into the mismatch of C_m and
+    C_X, e the vane's angle less the one the inertial channels integrate to (the kinematic
+    residual's vertical "gust" over the airspeed, high-passed at :data:`spectra.GUST_HIGHPASS_HZ`);
+    empty when the model is not evaluated along the vane (α held at its start); C_m's only when
+    it takes :data:`VANE_NOISE_SHARE` or more off C_m's mismatch RMS, C_X's always. ``gust`` is
+    the gust estimate already made from these channels; None makes it again (after sensor
+    corrections).
 
     The model evaluated along the vane passes the vane's error through its slopes (errors in
     variables); a Gauss-Markov wander is in the maneuver's band and survives the smoother. On a
@@ -110,7 +111,15 @@ def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mism
     40-50 % off C_Z's mismatch, and the cleaner C_Z showed a C_Z ΔV/V on F-16 nulls at 550
     and 700 ft/s and a C_Z,α̇ where a_z lagged (false findings). In gusts e is air, which the
     aerodynamics followed: the column then fits nothing (the air-share test,
-    :func:`spectra.air_share`, is this fit on C_Z)."""
+    :func:`spectra.air_share`, is this fit on C_Z).
+
+    C_X's column is in its fit whatever its share: a drag polar's slope grows with α, so the
+    wander e reaches C_X's mismatch as −(C_X,α + C_X''·Δα)·e, and its part Δα·e is what the
+    vane's Δα², which carries e too, fits (errors in variables). An independent script's
+    c172x null (173 ft/s, pitch 3-2-1-1 at 40 Hz) drew C_X α² −0.75 at t −8.2, the same
+    flight's noise-free copy −0.16 at t −4.8 (the propeller's thrust, which the constant-thrust
+    stand-in leaves in C_X); with the column, −0.55 at t −3.9, though it took 0.2 % of C_X's
+    mismatch RMS. Both sweeps kept every score with it."""
     if "alpha" not in along.states or np.ptp(along.states["alpha"]) == 0.0:
         return {}
     if gust is None:
@@ -123,7 +132,7 @@ def vane_noise_columns(p: Prepared, along: ModelAlong, slope_of, V0: float, mism
     A = np.column_stack([column[inner], np.ones(z.size)])
     left = z - A @ np.linalg.lstsq(A, z, rcond=None)[0]
     share = 1.0 - float(np.std(left)) / max(float(np.std(z)), 1e-300)
-    return {"Cm": column} if share >= VANE_NOISE_SHARE else {}
+    return ({"Cm": column} if share >= VANE_NOISE_SHARE else {}) | {"CX": vane_error_column(slope_of, gust, V0, "CX")}
 
 
 def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[str, np.ndarray],

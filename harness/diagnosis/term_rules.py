@@ -235,15 +235,16 @@ def withhold_force_drift_off_the_vane_wander(cands: list[Candidate], step: Stepw
     The model is evaluated along the vane, so the vane's wander is in the force mismatch
     times the model's C_Z,α (errors in variables). A Gauss-Markov wander is slow, and over a
     30 s record it may follow the airspeed's slow change by chance: an independent script's
-    c172x null drew a C_Z ΔV/V of −0.23 (t 7). The column is not kept in the force axes' fits
-    (it drew false findings there, :func:`stepwise_axes.vane_noise_columns`); it is asked
-    here only of a drift term, slow as the wander is."""
+    c172x null drew a C_Z ΔV/V of −0.23 (t 7). The column is not kept in C_Z's fit (it drew
+    false findings there, :func:`stepwise_axes.vane_noise_columns`); it is asked here only of
+    a drift term, slow as the wander is. C_X's fit holds it already (a term there entered
+    beside it)."""
     if gust is None or gust.w_fps is None:
         return
     inner = interior(p)
     for c in cands:
         if not (c.selected and c.effect == "flight_condition_drift" and c.channel in ("CX", "CZ")
-                and c.channel in step.selections):
+                and c.channel in step.selections and "vane_alpha_noise" not in step.nuisances.get(c.channel, {})):
             continue
         sel, by_key = step.selections[c.channel]
         key = next((k for k in sel.names if k in by_key and by_key[k].parameter == c.parameter), None)
