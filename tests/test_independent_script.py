@@ -546,6 +546,25 @@ def test_a_term_resting_on_an_uncertain_alpha_correction_is_not_named(tmp_path, 
     assert not term["selected"] and "rests on the correction for bias_alpha" in term["reason"], term["reason"]
 
 
+def test_an_alpha_vane_bias_named_withholds_the_lateral_terms_it_imitates(tmp_path):
+    """The package's F-15 (11,420 ft / 674.5 ft/s, doublets on each axis at 40 Hz, no h
+    channel) with its α vane 1° high: the bias is named on the longitudinal coefficient means,
+    and the model's lateral derivatives, evaluated at the vane's α, left a C_l,β change of
+    +0.0105 (t 14) and a C_n,p̂ of −0.060 (t −20), both named beside it until the named error
+    was asked of every axis (sensor_naming.withhold_imitated_by_named): it imitates 0.011 and
+    0.054 of them."""
+    model = _package_xml("f15")
+    rec, val = _pair(tmp_path, "f15", 11420.0, 674.5, 2906, 40.0, "dbl3", amplitude_deg=2.75)
+    for path in (rec, val):
+        _sensor_error(path, "alpha_rad", lambda t, x: x + np.radians(1.0))
+        _without_column(path, "h_ft")
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    assert [p for p, _ in _found(result)] == ["bias_alpha"]
+    for name in ("Cl_beta", "Cn_phat"):
+        term = next(c for c in result["candidates"] if c["parameter"] == name)
+        assert not term["selected"] and "the bias_alpha named" in term["reason"], term["reason"]
+
+
 def test_a_term_a_whole_uncertain_correction_makes_is_not_named(tmp_path, monkeypatch):
     """The package's c182, a null (5,010 ft / 196 ft/s, 3-2-1-1 on each axis at 50 Hz, half the
     noise, no h channel): the kinematics applied an α bias of 0.45° at t 3.8, and along the α so

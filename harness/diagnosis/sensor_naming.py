@@ -405,12 +405,17 @@ def withhold_imitated_by_named(cands: list[Candidate], imitated, applied: set[st
     (:data:`term_rules.DEPENDENT_SENSOR`) and those whose regressor it is; it is preferred
     over the coefficient changes it imitates. (A c172x recording at 5,000 ft / 190 ft/s whose
     a_z lagged 50 ms through a first-order filter named the a_z skew, 42 ± 7 ms, on the
-    kinematics and C_Z together, and beside it a C_Z,α̇ of +28 that the skew imitates.)"""
+    kinematics and C_Z together, and beside it a C_Z,α̇ of +28 that the skew imitates.) An
+    error of the α vane reaches every axis: the model is evaluated along the vane
+    (:func:`along.model_states`), and its lateral derivatives vary with α. (A probe's F-15
+    with its vane 1° high, 15,000 ft, doublets on each axis at 40 Hz, had the bias named on
+    C_X, C_Z and C_m and beside it a C_l,β change of +0.0105 (t 14) and a C_n,p̂ of −0.060
+    (t −20), the model's C_l,β and C_n,p̂ at the vane's α.)"""
     named = [c for c in cands if c.selected and c.effect in SENSOR_EFFECTS and c.parameter not in applied]
     for sensor in named:
         channel = sensor.channel
         for c in cands:
-            reached = channel in (DEPENDENT_SENSOR.get(c.channel or ""), regressor_channel(c))
+            reached = channel == "alpha" or channel in (DEPENDENT_SENSOR.get(c.channel or ""), regressor_channel(c))
             if not (c.selected and reached and c.test.startswith("stepwise")):
                 continue
             change = abs(term_change(c))
