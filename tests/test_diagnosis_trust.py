@@ -88,6 +88,28 @@ def test_assumptions_name_the_stand_ins_for_missing_channels(tmp_path):
     assert written["assumptions"] and written["not_checked"]
 
 
+def test_a_tentative_sensor_correction_does_not_make_the_model_another_aircraft():
+    """verdict.check_model_represents: the lift test is asked again along the channels as
+    recorded where the analysis applied sensor corrections (a probe's 737 with an α bias of
+    1.9° applied at kinematic t 3.2: lift −0.123 along the corrected α, −0.270 along the
+    recorded, the recording's −0.271); refused only when both are off."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.verdict import check_model_represents
+    n = 100
+    trim = SimpleNamespace(S_ft2=1171.0, b_ft=94.7, cbar_ft=12.31)
+    a = SimpleNamespace(prepared=SimpleNamespace(meta={"geometry": {"S_ft2": 1171.0, "b_ft": 94.7, "cbar_ft": 12.31}}),
+                        aero=SimpleNamespace(trim=trim, trim_failed="", coefficients={"CZ": np.full(n, -0.123)}),
+                        mismatch={"CZ": np.full(n, -0.148)}, applied={"bias_alpha": 0.0333})
+    recorded = lambda cz: (lambda: SimpleNamespace(measured={"CZ": np.full(n, -0.271)},
+                                                   aero=SimpleNamespace(coefficients={"CZ": np.full(n, cz)})))
+    check_model_represents(a, "737", recorded(-0.270))
+    with pytest.raises(DiagnosisError, match="averages -0.123 where the recording's is -0.271"):
+        check_model_represents(a, "737", recorded(-0.12))
+    with pytest.raises(DiagnosisError, match="does not represent"):
+        check_model_represents(SimpleNamespace(**{**vars(a), "applied": {}}), "737", recorded(-0.270))
+
+
 def test_model_of_another_aircraft_is_refused(tmp_path, shared_dir):
     rec = fly_maneuver(FlightSpec(input=default_three_axis_input()))
     path = _write(rec, tmp_path / "f16.csv")

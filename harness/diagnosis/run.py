@@ -13,6 +13,7 @@ import numpy as np
 
 from harness.atomic import jsonable, write_atomic, write_text_atomic
 from harness.diagnosis.analysis import analyse
+from harness.diagnosis.along import model_along
 from harness.diagnosis.augmented import (analysed, calibration_assumptions, fly_all, refine_in_the_loop, replay_before,
                                          sensor_models, terms_of, unsupported_in_the_loop, with_calibration,
                                          recording_start_references, write_model)
@@ -240,7 +241,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     if validation is not None and pool is not None and choosing:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     a = analyse(p, aircraft, ic)
-    check_model_represents(a, model)
+    check_model_represents(a, model, lambda: model_along(p, aircraft, ic))
     befores = {"identification": replay_before(p, aircraft, a)}
     av = None
     if validation is not None:
