@@ -1888,7 +1888,7 @@ def test_an_alpha_square_must_hold_inside_the_maneuver_window_of_a_long_record(s
     assert maneuver_window(p) is None
 
 
-def test_the_model_goes_through_the_common_filter_after_its_nonlinear_terms():
+def test_the_model_goes_through_the_common_filter_after_its_nonlinear_terms(monkeypatch):
     """along.filtered: the model's coefficients along the raw states, through the common
     filter, are the measured side's own operation (the filter of what the aerodynamics did),
     so a drag polar's α² leaves no mismatch; the model of the filtered α leaves the power the
@@ -1908,9 +1908,24 @@ def test_the_model_goes_through_the_common_filter_after_its_nonlinear_terms():
     k = 7.0                                                  # the polar's curvature, per rad²
     measured = sine_series_filter(k * alpha ** 2, weights)   # Eq. 1 on filtered accelerations
     from types import SimpleNamespace
+
+    from harness.diagnosis import along
+    from harness.diagnosis.prepare import COEFFICIENTS
     trim = SimpleNamespace(thrust_lbf=0.0)
     model = filtered(AeroAlong({"CX": k * alpha ** 2}, {}, {}, trim), weights).coefficients["CX"]
     assert np.allclose(model, measured, atol=1e-12)
+    # along.model_along itself: the model (a drag polar in the state it is given) along the
+    # recorded α, then the filter; the measured side the filter of the true polar
+    zero = np.zeros(n)
+    monkeypatch.setattr(along, "aero_along", lambda aircraft, ic, states, surfaces, alphadot: AeroAlong(
+        {c: k * states["alpha"] ** 2 if c == "CX" else zero for c in COEFFICIENTS}, {}, {}, trim))
+    monkeypatch.setattr(along, "measured_coefficients", lambda *args: {c: measured if c == "CX" else zero
+                                                                        for c in COEFFICIENTS})
+    monkeypatch.setattr(along, "thrust_stand_in", lambda p, thrust: 0.0)
+    p = SimpleNamespace(raw={"alpha": alpha}, smooth={"alpha": sine_series_filter(alpha, weights)},
+                        deriv={"alpha": zero}, driven=("alpha",), moved=(), start={"alpha": 0.03}, n=n,
+                        own_noise={}, altitude=None, weights=weights, meta={}, mass=None)
+    assert np.allclose(along.model_along(p, None, None).mismatch()["CX"], 0.0, atol=1e-12)
     old = k * sine_series_filter(alpha, weights) ** 2       # the model of the filtered α
     inner = slice(250, n - 250)
     da = sine_series_filter(alpha, weights)[inner] - 0.03

@@ -4,11 +4,12 @@ represent the recording refused (:class:`DiagnosisError`)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.along import interior
+from harness.diagnosis.along import ModelAlong, interior
 from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.gust_rules import NOT_IN_GUSTS, NOT_IN_TURBULENCE, vane_wander, voids_kinematics
 from harness.diagnosis.kinematics import time_base_problem
@@ -373,7 +374,7 @@ def _lift_represented(measured: float, modelled: float) -> bool:
     return abs(measured) < 0.05 or 1.0 / LIFT_FACTOR <= modelled / measured <= LIFT_FACTOR
 
 
-def check_model_represents(a: Analysis, model: str, as_recorded=None) -> None:
+def check_model_represents(a: Analysis, model: str, as_recorded: Callable[[], ModelAlong] | None = None) -> None:
     """Refuse a model that cannot stand for the recorded aircraft: its reference geometry
     differs from the recording's by more than :data:`GEOMETRY_FACTOR`, or its normal-force
     coefficient along the recorded states differs from the measured one by more than
