@@ -972,3 +972,20 @@ def test_a_beta_vane_scale_s_side_gust_is_not_read_as_turbulence(tmp_path, monke
     found = _found(result)
     assert [p for p, _ in found] == ["scale_beta"]
     assert found[0][1] == pytest.approx(0.15, abs=0.03)
+
+
+def test_a_late_yaw_gyro_names_no_scale_the_first_order_skew_leaves(tmp_path, monkeypatch):
+    """The package's A-4 (11,750 ft / 539 ft/s, aileron then rudder sweeps at 200 Hz) with r
+    71 ms late (a probe's A-4, the same): the skew is named, and beside it the linearised
+    kinematics read a scale of about +0.05 on r (t 5) that C_n, corrected by the same
+    first-order column, corroborated: τ²r̈/2 at the sweep's frequencies is a scale of r.
+    With r shifted exactly by the skew the scale stands at t 1; it is not named."""
+    _with_sweeps(monkeypatch)
+    model = _package_xml("A4")
+    rec = fly(tmp_path / "id.csv", "A4", 11752.0, 539.0, 3081, 200.0, "sweep_lat", amplitude_deg=2.0)
+    _sensor_error(rec, "r_rps", lambda t, x: np.interp(t - 0.0714, t, x))
+    result = diagnose(model, rec, tmp_path / "out", calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["skew_r"] and found[0][1] == pytest.approx(0.0714, abs=0.01)
+    scale = next(c for c in result["candidates"] if c["parameter"] == "scale_r")
+    assert not scale["selected"]

@@ -11,6 +11,7 @@ from harness.diagnosis import corroborate
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along
 from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.exact_skew import scale_beside_exact_skew
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
@@ -277,6 +278,27 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
         for c in cands:
             if sensor.selected and c.details.get("sensor_rival") == sensor.parameter:
                 c.reason += f"; explained by the {sensor.parameter} named"
+
+
+def withhold_scale_left_by_a_linearised_skew(cands: list[Candidate], kin: KinematicResult, recorded: Prepared) -> None:
+    """Deselect a named scale factor that falls below :data:`AMBIGUOUS_T` with its channel
+    shifted exactly by the time skew the kinematics take on it
+    (:func:`exact_skew.scale_beside_exact_skew`, on the ``recorded`` channels): it is the
+    first-order skew column's leftover, τ²ẍ/2, a scale of the channel at one frequency, which
+    the coefficient mismatch, corrected by the same column, shows too."""
+    for c in cands:
+        if not (c.selected and c.effect == "sensor_scale"):
+            continue
+        t = scale_beside_exact_skew(kin, recorded, c.parameter)
+        if t is None or t >= AMBIGUOUS_T:
+            continue
+        channel = kin.parameters[c.parameter].channel
+        c.selected = False
+        c.details["beside_exact_skew_t"] = t
+        c.reason = (f"not named: with {channel} shifted exactly by the skew_{channel} the kinematics take it stands "
+                    f"at t = {t:.1f}; what it fitted is the first-order skew column's leftover (τ²ẍ/2, a scale of "
+                    f"{channel} at one frequency), which the coefficient mismatch, corrected by the same column, "
+                    f"shows too (it had been: {c.reason})")
 
 
 def withhold_corroborated_rivals(named: list[Candidate], kin: KinematicResult) -> None:
