@@ -989,3 +989,21 @@ def test_a_late_yaw_gyro_names_no_scale_the_first_order_skew_leaves(tmp_path, mo
     assert [p for p, _ in found] == ["skew_r"] and found[0][1] == pytest.approx(0.0714, abs=0.01)
     scale = next(c for c in result["candidates"] if c["parameter"] == "scale_r")
     assert not scale["selected"]
+
+
+def test_a_pitch_stiffness_change_between_the_737_s_placements_names_no_shift(tmp_path):
+    """The package's 737 (12,000 ft / 588 ft/s, pitch multisine at 40 Hz, flown with its XML's
+    aerodynamic reference point) with C_m,α 0.35 higher about trim in an XML copy: the change
+    moves C_m as a reference point forward does, and the moments put the point between the
+    two placements (k about 0.4-0.6, each end many standard errors away). Placed at the
+    nearer, a moment-reference shift was named in the change's place (a probe's 737: 0.58 ft,
+    t 68). The placement is then itself uncertain, and no shift is named."""
+    from independent_script import trimmed
+    alpha0 = trimmed("737", 11946.0, 588.0)["aero/alpha-rad"]
+    root = _f16_with_extra_term(tmp_path / "root", "PITCH", ("aero/qbar-psf", "metrics/Sw-sqft", "metrics/cbarw-ft"),
+                                0.35, _from_trim(alpha0), model="737")
+    rec = fly(tmp_path / "id.csv", "737", 11946.0, 588.0, 3113, 40.0, "ms_pitch", amplitude_deg=3.0, root=root)
+    result = diagnose("737", rec, tmp_path / "out", calibrate=False)
+    reference = next(a for a in result["assumptions"] if a["item"] == "aerodynamic reference point")
+    assert "as the recording's moments say" in reference["stood_in_by"], reference
+    assert [p for p, _ in _found(result)] in ([], ["Cm_alpha"])

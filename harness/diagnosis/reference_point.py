@@ -93,6 +93,15 @@ class ReferenceChoice:
         """findings.json's ``assumptions`` entry."""
         return {"item": "aerodynamic reference point", "missing": "-", "stood_in_by": self.reason}
 
+    @property
+    def between(self) -> bool:
+        """Whether the moments put the reference point between the two placements, at least
+        :data:`REFERENCE_Z` standard errors from each: neither fits, and the one taken is
+        only the nearer (:func:`withhold_shift_between_placements`)."""
+        if self.k is None or not self.std_error:
+            return False
+        return 0.0 < self.k < 1.0 and min(self.k, 1.0 - self.k) >= REFERENCE_Z * self.std_error
+
 
 # The forces each moment's change between placements is split along (module docstring).
 PARTS = {"Cl": ("CY", "CZ"), "Cm": ("CX", "CZ"), "Cn": ("CX", "CY")}
@@ -211,3 +220,22 @@ def choose_reference_point(p: Prepared, aircraft: Aircraft, ic: InitialCondition
     return ReferenceChoice(aircraft, None, None,
                            f"{here}: the recording does not tell ({'; '.join(texts)} of the way to {there}); a "
                            f"recording flown with it {there} shows a moment-reference offset")
+
+
+def withhold_shift_between_placements(cands: list, reference: ReferenceChoice | None) -> None:
+    """Deselect a moment-reference shift when the recording's moments put the reference point
+    between the placements (:attr:`ReferenceChoice.between`): the placement is itself what a
+    shift measures, and the shift named is then the distance to the nearer placement, which
+    an effect that moves the same parts (a C_m,α change on a pitch maneuver) makes as well.
+    A probe's stock 737 (11,900 ft / 588 ft/s, pitch sweep, flown with the XML's placement)
+    with C_m,α 0.35 higher read k = 0.44 ± 0.03 and, placed on the c.g., had a 0.58 ft shift
+    named (t 68) in the C_m,α change's place."""
+    if reference is None or not reference.between:
+        return
+    for c in cands:
+        if c.selected and c.effect == "cg_offset":
+            c.selected = False
+            c.reason = (f"not named: the model's aerodynamic reference point is itself uncertain (the moments put it "
+                        f"k = {reference.k:.2f} ± {reference.std_error:.2g} of the way between its two placements, "
+                        "neither within their entry distance); a shift of the moment reference is what the other "
+                        f"placement would be (it had been: {c.reason})")

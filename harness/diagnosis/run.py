@@ -22,7 +22,7 @@ from harness.diagnosis.fcs_surfaces import choose_secondary_surfaces
 from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.mode_model import attach_mode_models
 from harness.diagnosis.prepare import instruments_at_cg, prepare
-from harness.diagnosis.reference_point import choose_reference_point
+from harness.diagnosis.reference_point import choose_reference_point, withhold_shift_between_placements
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
 from harness.diagnosis.validation import after_mismatch, undecided, validation_check
 from harness.diagnosis.verdict import (DiagnosisError, assumptions, check_model_represents, check_time_base,
@@ -241,6 +241,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     if validation is not None and pool is not None and choosing:
         pending = pool.pool.submit(analysed, recs["validation"], "validation", aircraft)
     a = analyse(p, aircraft, ic)
+    withhold_shift_between_placements(a.candidates, reference)
     check_model_represents(a, model, lambda: model_along(p, aircraft, ic))
     befores = {"identification": replay_before(p, aircraft, a)}
     av = None
