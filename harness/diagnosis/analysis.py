@@ -32,7 +32,8 @@ from harness.diagnosis.sensor_rules import (applied_sensor_values, biases_of_con
 from harness.diagnosis.spectra import structural_peak
 from harness.diagnosis.stepwise_axes import (aero_candidates, delay_scans, offset_candidate, pinned_shift,
                                              stepwise_fits, vane_noise_columns, withhold_on_moving_throttle,
-                                             withhold_shift_within_thrust, withhold_thrust_drift)
+                                             withhold_shift_within_thrust, withhold_stiffness_a_shift_makes,
+                                             withhold_thrust_drift)
 from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimate, imitation, inertial_alpha_sensors,
                                           note_surface_scale, note_untested_coupling,
                                           withhold_off_the_integration_drift,
@@ -134,6 +135,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     if step.pinned is not None:
         cands.append(pinned_shift(step.pinned, p, aero.trim))
     withhold_shift_within_thrust(cands, step, p, aero.trim, mismatch, measured)
+    withhold_stiffness_a_shift_makes(cands, step, p, mismatch, measured)
     withhold_on_moving_throttle(cands, p, propeller)
     withhold_beside_the_accelerometer(cands, step.selections, p, as_evaluated, noise)
     # the rules that keep a term from being named when something else would imitate it

@@ -240,6 +240,53 @@ def withhold_shift_within_thrust(cands: list[Candidate], step: StepwiseFits, p: 
                         "the shift from the C_m,α change its C_Z column imitates")
 
 
+def withhold_stiffness_a_shift_makes(cands: list[Candidate], step: StepwiseFits, p: Prepared,
+                                     mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> None:
+    """A C_m,α change is not named when a moment-reference shift reads as it and C_m's mean
+    carries the mistrim that shift predicts: the shift Δx whose Δx·C_Z/c̄ is nearest the
+    change's own contribution (least squares on the measured C_Z), tested by
+    :func:`shift_mistrim_test` beside C_m's other terms, not refuted, its mistrim's own shift
+    of the same sign :data:`CG_MEAN_Z` standard errors from zero, within a factor
+    :data:`SHIFT_MEAN_FACTOR` of Δx and at least :data:`candidates.PRACTICAL_SHARE` of C_m's
+    excursion. The pitch maneuver's C_Z follows α, and the stepwise can give the change to
+    either column; a C_m,α change about trim explains nothing of C_m's constant. A probe's
+    c172x (7,150 ft / 160 ft/s, pitch sweep, thrust not recorded) with its reference point
+    0.16 ft from the model's had the stepwise's shift refuted by its wrong sign (its C_Z column
+    shared with the α one), and the C_m,α change of +0.32 (a 0.15 ft shift) named in its place
+    while C_m's constant said 0.24 ft."""
+    sel, by_key = step.selections.get("Cm", (None, {}))
+    inner = interior(p)
+    cbar = p.meta["geometry"]["cbar_ft"]
+    cz = measured["CZ"][inner] - np.mean(measured["CZ"][inner])
+    for c in cands:
+        if not (c.selected and c.effect == "coefficient_error" and c.parameter == "Cm_alpha"
+                and c.test.startswith("stepwise")):
+            continue
+        key = next((k for k, t in by_key.items() if t.parameter == c.parameter), None)
+        change = c.details.get("change")
+        if key is None or not change or float(cz @ cz) <= 0.0:
+            continue
+        contribution = change / by_key[key].scale * by_key[key].column[inner]
+        dx = cbar * float(cz @ (contribution - np.mean(contribution))) / float(cz @ cz)
+        test = shift_mistrim_test(p, dx, "Cm", step.selections, step.nuisances, mismatch, measured)
+        if (test is None or test.refuted or np.sign(test.dx_ft) != np.sign(dx)
+                or abs(test.dx_ft) < CG_MEAN_Z * test.std_error_ft or test.share < cand.PRACTICAL_SHARE
+                or not 1.0 / SHIFT_MEAN_FACTOR <= test.dx_ft / dx <= SHIFT_MEAN_FACTOR):
+            continue
+        c.selected = False
+        c.details["shift_alternative"] = {"dx_ft": dx, "mistrim_dx_ft": test.dx_ft,
+                                          "mistrim_std_error_ft": test.std_error_ft}
+        c.reason = (f"not named: a moment-reference shift of {dx:.3g} ft reads as this change on a maneuver whose C_Z "
+                    f"follows α, and C_m's constant carries the mistrim of a {test.dx_ft:.3g} ± "
+                    f"{test.std_error_ft:.2g} ft shift, which a C_m,α change about trim does not make; the recording "
+                    f"cannot tell the two apart (it had been: {c.reason})")
+
+
+# How far (a factor either way) the shift C_m's mistrim says may lie from the one a C_m,α
+# change reads as, for the two to be taken as one (withhold_stiffness_a_shift_makes).
+SHIFT_MEAN_FACTOR = 2.0
+
+
 def _without_shift(p: Prepared, mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray],
                    dx_ft: float) -> dict[str, np.ndarray]:
     """The mismatch less what a moment-reference shift of ``dx_ft`` puts in it: Δx·C_Z/c̄ in
