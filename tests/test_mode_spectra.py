@@ -164,3 +164,17 @@ def test_a_mode_the_identification_could_not_ring_is_named_on_the_validation_alo
     driven = record(0.01, False)
     assert spectra.predicted_peak_p(driven, val, "q", pv.frequency_hz) < spectra.MODE_CONFIRM_P
     assert name_mode_on_both(_analysis(driven, None), _analysis(val, pv)) is None
+
+
+def test_a_mode_under_a_tenth_of_the_practical_bias_is_not_named():
+    """A peak significant against a noise-free record's rounding (a probe's c172x at 200 Hz:
+    75 Hz in a_y, 6e-10 g RMS, p 6e-20) is not a mode worth naming; one carrying the
+    smallest true mode's RMS of the sweeps (q 0.00096 rad/s) is."""
+    from harness.diagnosis.gust_rules import MODE_PRACTICAL_SHARE, mode_candidate
+    from harness.diagnosis.kinematics import PRACTICAL
+    from harness.diagnosis.spectra import PeakTest
+    tiny = mode_candidate(PeakTest("ay", 74.99, 0.25, 5.8e-10, 4.7, 5.9e-20, 0.0008), True, "peak")
+    assert not tiny.selected and tiny.reason.startswith("not named, too small to matter")
+    real = mode_candidate(PeakTest("q", 9.51, 0.05, 0.00096, 9.0, 1e-12, 0.029), True, "peak")
+    assert real.selected and real.reason == "peak"
+    assert 0.00096 > MODE_PRACTICAL_SHARE * PRACTICAL["bias"]["q"]

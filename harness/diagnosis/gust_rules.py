@@ -9,7 +9,7 @@ from scipy.stats import linregress
 from harness.diagnosis.along import ModelAlong, model_along, slope_function
 from harness.diagnosis.candidates import VANE_ALPHA_RATE_AXES
 from harness.diagnosis.evidence import Candidate
-from harness.diagnosis.kinematics import kinematic_residuals
+from harness.diagnosis.kinematics import PRACTICAL, kinematic_residuals
 from harness.diagnosis.prepare import Prepared, interior_slice
 from harness.diagnosis.spectra import AirShare, FISHER_P, air_share, gust_estimate
 from models.aircraft import Aircraft
@@ -196,11 +196,25 @@ def withhold_in_light_gusts(cands: list[Candidate], why: str) -> None:
                         f"rate ẇ_g/V that the aerodynamics see ({why})") if inertial_rate else f"not named: {why}"
 
 
+# A mode is worth naming when the RMS its peak carries in the channel reaches this share of
+# the smallest bias worth naming there (kinematics.PRACTICAL): a tenth of 0.15 deg/s on a
+# gyro, of 0.015 g on an accelerometer. The sweeps' and probes' true modes carry 0.001-0.009
+# rad/s in q and 0.014-0.02 g in a_z; a probe's noise-free c172x at 200 Hz, its values
+# rounded to 8 digits, had a 75 Hz "mode" of 6e-10 g in a_y named (p 6e-20).
+MODE_PRACTICAL_SHARE = 0.1
+
+
 def mode_candidate(peak, selected: bool, reason: str) -> Candidate:
     """The structural-mode candidate of spectral peak ``peak`` (:class:`spectra.PeakTest`):
     its frequency, with −log10 p as its t and, as the share it explains, the peak's excess
     power over the variance of what the common filter leaves of the channel (the ordinate
-    over its local median is kept as ``details['peak_over_median']``)."""
+    over its local median is kept as ``details['peak_over_median']``). Not selected when the
+    peak's RMS is under :data:`MODE_PRACTICAL_SHARE` of the channel's practical bias."""
+    floor = MODE_PRACTICAL_SHARE * PRACTICAL["bias"].get(peak.channel, 0.0)
+    if selected and peak.amplitude < floor:
+        selected = False
+        reason = (f"not named, too small to matter: {peak.amplitude:.2g} RMS in {peak.channel}, under {floor:.2g} "
+                  f"({MODE_PRACTICAL_SHARE:g} of the smallest bias worth naming there); the peak: {reason}")
     return Candidate("structural_mode", None, peak.channel, "mode_frequency_hz", peak.frequency_hz,
                      peak.std_error_hz, float(-np.log10(max(peak.p_value, 1e-300))), min(peak.share, 1.0), "Hz",
                      "residual-spectrum peak over its local median", selected, reason,
