@@ -13,13 +13,15 @@ the mode, u the surface's Wiener estimate, with f and ζ found by variable proje
 gains solved linearly for each trial f, ζ)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import ndimage, optimize, signal, stats
 
 from estimators.filter_error import MAD_TO_SIGMA
+from harness.diagnosis.kinematics import T_IN
 from harness.diagnosis.prepare import Prepared, interior_slice
+from harness.diagnosis.sensor_rules import kinematic_estimate, plausible_kinematic_check
 from harness.diagnosis.spectra import MODE_CHANNELS, MODE_DRIVERS
 
 # The damping ratios tried before refinement (structural modes: 0.5-20 % of critical).
@@ -306,3 +308,45 @@ def with_mode_band(p: Prepared, smooth: dict[str, np.ndarray], modes: list[Drive
             if c in p.raw and c in out:
                 out[c] = out[c] + band_part(p.raw[c] - smooth[c], p.dt, m.band_hz())
     return out
+
+
+# The sensor errors a modelled mode's own output can make on the channels it rings in.
+MODE_SENSOR_EFFECTS = ("sensor_scale", "sensor_time_skew", "sensor_offset")
+
+
+def withhold_sensor_errors_a_mode_makes(findings: list, p: Prepared) -> list:
+    """The findings less the sensor errors of a channel a modelled mode rings in
+    (:func:`attach_mode_models`) that the kinematics no longer take, at their entry t, with
+    the mode's output over the identification maneuver ``p`` taken out of its channels
+    (:func:`mode_outputs`); each one withheld is deselected with the reason. A mode driven by
+    a surface rings below its resonance too (its quasi-static part follows the surface's
+    rate), inside the maneuver's band, where the kinematics read it as the gyro's own error:
+    a probe's F-4N (16,100 ft / 679 ft/s, three-axis 2-1-1s at 50 Hz) with a 10.1 Hz mode
+    driven by the stabilator's rate in q and a_z had the mode named, and beside it a q skew of
+    30 ms and a q scale of +0.097 (t 7.7 and 7.3)."""
+    outputs = {}
+    for f in findings:
+        if f.effect == "structural_mode" and f.details.get("mode_model"):
+            for c, x in mode_outputs(DrivenMode.from_dict(f.details["mode_model"]), p).items():
+                outputs[c] = outputs.get(c, 0.0) + x
+    suspects = [f for f in findings if f.effect in MODE_SENSOR_EFFECTS and _channel_of(f) & set(outputs)]
+    if not suspects:
+        return findings
+    kin = plausible_kinematic_check(replace(p, raw=p.raw | {c: p.raw[c] - x for c, x in outputs.items()}))
+    kept = []
+    for f in findings:
+        found = kinematic_estimate(kin, f.parameter) if f in suspects else None
+        if f in suspects and (found is None or found[1] < T_IN):
+            t = 0.0 if found is None else found[1]
+            f.selected = False
+            f.reason = (f"not named: with the named mode's output taken out of {', '.join(sorted(outputs))} the "
+                        f"kinematics stand it at t = {t:.1f}, under their entry t; the mode, driven by a surface, "
+                        f"rings below its resonance too (it had been: {f.reason})")
+            continue
+        kept.append(f)
+    return kept
+
+
+def _channel_of(f) -> set[str]:
+    """The recorded channels a sensor finding's error sits on (an accelerometer position: all three)."""
+    return {"ax", "ay", "az"} if f.channel == "accelerometer" else {f.channel}
