@@ -1935,3 +1935,21 @@ def test_the_model_goes_through_the_common_filter_after_its_nonlinear_terms(monk
     assert fit(measured - old) < -0.05 * k                   # the artifact the old order left (-14 % of k)
 
 
+
+
+def test_the_mass_assumption_names_only_the_keys_the_recording_leaves_constant():
+    """The assumption names the mass keys that stand in as metadata constants: every one when
+    no mass channel is recorded, the rest when only some are (an independent script's
+    recording with the inertias as channels and the mass in its metadata was reported as
+    having no mass channels at all)."""
+    from harness.diagnosis.prepare import _stand_ins
+    from maneuvers.format_rules import MASS_KEYS
+    raw = {s: np.zeros(3) for s in ("thrust", "de", "da", "dr")}
+    meta = {"thrust_offset_ft": 0.0, "sensors": {"accelerometer_ft": [0.0, 0.0, 0.0]}}
+    mass = {a["item"]: a for a in _stand_ins(raw, meta, ("t_s",))}["mass and inertia"]
+    assert mass["missing"] == "mass channels" and "metadata's constants" in mass["stood_in_by"]
+    inertias = MASS_KEYS[1:]
+    mass = {a["item"]: a for a in _stand_ins(raw, meta, ("t_s",) + inertias)}["mass and inertia"]
+    assert mass["missing"] == "mass_slug channels"
+    assert all(k in mass["stood_in_by"] for k in inertias)
+    assert "mass and inertia" not in {a["item"] for a in _stand_ins(raw, meta, ("t_s",) + MASS_KEYS)}

@@ -11,6 +11,7 @@ from estimators.coefficients import accelerometer_at_cg, force_coefficients, mom
 from estimators.differentiation import local_polynomial_derivative
 from estimators.smoothing import optimal_fourier_smoother, sine_series_derivative, sine_series_filter
 from harness.isa import density_altitude_ft
+from maneuvers.format_rules import MASS_KEYS
 from maneuvers.recording import Recording
 from models.constants import BODY_COEFFICIENTS, SURFACES
 from models.errors import UserError
@@ -431,9 +432,13 @@ def _stand_ins(raw: dict[str, np.ndarray], meta: dict, columns: tuple[str, ...],
         out.append({"item": "surfaces not recorded", "missing": ", ".join(absent),
                     "stood_in_by": "held at the model's trim deflection throughout (recording-format: only the "
                                    "surfaces that moved are required); a term on them cannot be tested"})
-    if "mass_slug" not in columns:
-        out.append({"item": "mass and inertia", "missing": "mass channels",
-                    "stood_in_by": "the metadata's constants, for the whole maneuver"})
+    constant = [k for k in MASS_KEYS if k not in columns]
+    if constant:
+        given = len(constant) < len(MASS_KEYS)
+        out.append({"item": "mass and inertia", "missing": ", ".join(constant) + " channels" if given else
+                    "mass channels", "stood_in_by": "the metadata's constants, for the whole maneuver"
+                    + (f" (the recording's channels for {', '.join(k for k in MASS_KEYS if k in columns)})"
+                       if given else "")})
     sensors = meta.get("sensors") or {}
     if meta.get("accelerometer_at_cg"):
         out.append({"item": "accelerometer position", "missing": "-",
