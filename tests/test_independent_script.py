@@ -3,6 +3,7 @@ multisines through a measured actuator, other sample rates, noise levels and uni
 conventions) — the kind of recording an evaluator's own script makes (issue 12)."""
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -1036,10 +1037,11 @@ def _with_driven_mode(path, frequency_hz: float, damping: float, q_rms: float, a
     with open(path, newline="") as fh:
         rows = list(csv.reader(fh))
     head, X = rows[0], np.array(rows[1:], dtype=float)
-    t, de = X[:, 0], X[:, head.index("de_rad")]
+    deg = "de_deg" in head  # the script's degree convention: angles in deg, rates in deg/s
+    t, de = X[:, 0], X[:, head.index("de_deg" if deg else "de_rad")]
     w = 2 * np.pi * frequency_hz
     y = signal.lsim(([1.0, 0.0], [1.0, 2 * damping * w, w * w]), de - de[0], t)[1]
-    for column, rms in (("q_rps", q_rms), ("az_g", az_rms)):
+    for column, rms in (("q_dps" if deg else "q_rps", np.degrees(q_rms) if deg else q_rms), ("az_g", az_rms)):
         X[:, head.index(column)] += y * rms / np.std(y)
     with open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
@@ -1061,3 +1063,49 @@ def test_a_driven_mode_names_no_gyro_error_from_its_quasi_static_part(tmp_path, 
     result = diagnose(model, rec, tmp_path / "out", calibrate=False)
     found = [p for p, _ in _found(result)]
     assert found == ["mode_frequency_hz"]
+
+
+def _accelerometer_told_at(path, x_ft: float) -> None:
+    """Write into the recording's metadata that its accelerometer is ``x_ft`` ahead of the c.g."""
+    meta_path = Path(path).with_suffix(".meta.json")
+    meta = json.loads(meta_path.read_text())
+    meta["sensors"] = {"accelerometer_ft": [x_ft, 0.0, 0.0]}
+    meta_path.write_text(json.dumps(meta))
+
+
+def test_a_mode_the_carry_puts_into_a_z_is_not_read_as_the_accelerometer_s_position(tmp_path):
+    """The probe's seed 3454 (tests/probe/gen.py, jsbsim and numpy only): a T-37 (17,100 ft /
+    423 ft/s, stabilator 2-1-1s at 25 Hz) whose accelerometer sits 5.3 ft aft and 1.7 ft below
+    the c.g., as its metadata say, with a 4.5 Hz mode driven by the stabilator's rate in q and
+    a_z. At 25 Hz the mode lies inside the common filter's band (6.1 Hz), and the carry to the
+    c.g. put the gyro's modal q̇ times the arm into a_z, which the force mismatch read as the
+    accelerometer 4.8 ft from where the metadata put it (t 38). The position it reads grows
+    with the band (2.2 ± 0.3 ft below 3 Hz); a rigid offset does not
+    (stepwise_axes._offset_by_band): not named."""
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3454", str(tmp_path)],
+                   check=True, capture_output=True)
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert truth["aircraft"] == "T37" and truth["effect"] == "structural_mode"
+    result = diagnose(_package_xml("T37"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
+                      calibrate=False)
+    assert "x_accelerometer" not in [p for p, _ in _found(result)]
+    offset = next(c for c in result["candidates"] if c["parameter"] == "x_accelerometer")
+    assert "not a rigid offset" in offset["reason"], offset["reason"]
+
+
+def test_an_accelerometer_elsewhere_than_the_metadata_says_is_named_after_the_carry(tmp_path, monkeypatch):
+    """The J-3 Cub of :func:`test_an_accelerometer_ahead_of_the_cg_is_named_once` with its
+    accelerometer 8 ft ahead and the metadata saying 4 ft: carried from 4 ft, the rest, a rigid
+    4 ft, reads the same in every band and is named."""
+    model = _package_xml("J3Cub")
+    _with_multisteps(monkeypatch)
+    rec, val = _pair(tmp_path, "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
+                     amplitude_deg=2.94)
+    for path in (rec, val):
+        _accelerometer_ahead(path, 8.0)
+        _accelerometer_told_at(path, 4.0)
+    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["x_accelerometer"] and found[0][1] == pytest.approx(4.0, rel=0.25)

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import signal
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
 from estimators.least_squares import SingularRegressorsError, partial_correlation
@@ -356,11 +357,21 @@ def stacked_forces(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str
     return Z, X, I
 
 
-def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float]) -> OffsetTest:
+def accelerometer_offset(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                         below_hz: float | None = None) -> OffsetTest:
     """Least squares of the stacked, noise-weighted force mismatches on the accelerometer
-    position (with an intercept per axis), colored-residual standard errors."""
+    position (with an intercept per axis), colored-residual standard errors; ``below_hz``:
+    the mismatches and the columns alike low-passed there first (a fourth-order Butterworth
+    run forward and back, each axis apart), which a rigid offset's linear relation survives."""
     Z, X, I = stacked_forces(p, mismatch, noise)
     X = [X[a] for a in "xyz"]
+    if below_hz is not None:
+        b, a = signal.butter(4, below_hz, fs=1.0 / p.dt)
+        m = Z.size // len(FORCE_AXES)
+
+        def low(v: np.ndarray) -> np.ndarray:
+            return np.concatenate([signal.filtfilt(b, a, v[k * m:(k + 1) * m]) for k in range(len(FORCE_AXES))])
+        Z, X = low(Z), [low(x) for x in X]
     keep = [i for i in range(3) if np.ptp(X[i]) > 1e-12]
     theta, se, resid = colored_fit(Z, [X[i] for i in keep] + I, [f"r{i}" for i in keep] + list(FORCE_AXES),
                                    constant=False)

@@ -9,6 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from estimators.colored_stepwise import colored_fit
+from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import ModelAlong, interior
 from harness.diagnosis.evidence import Candidate
@@ -35,6 +36,9 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
            and off.gain >= cand.MIN_GAIN / 2 and share >= cand.PRACTICAL_SHARE)
     reason = "significant and practical" if sel else \
         "not significant, under 1.5 ft, or under 4 % of the force coefficients' excursion"
+    band = _offset_by_band(p, mismatch, noise, off) if sel and p.meta.get("accelerometer_at_cg") else ""
+    if band:
+        sel, reason = False, band
     rival = cand.offset_rival(p, mismatch, noise, off) if sel else None
     if rival is not None:  # the mismatch is left whole for the stepwise fits to judge
         sel = False
@@ -52,6 +56,47 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
                            "t_xyz": list(off.t)}
                           | ({"offset_rival": rival.parameter, "offset_rival_t": rival.t_rival,
                               "offset_t_beside": rival.t_offset} if rival else {}))
+
+
+# A rigid accelerometer offset reads the same in every band: the position read off the force
+# mismatches low-passed at OFFSET_BAND_SHARE of the common filter's cut-off may lie at most
+# OFFSET_BAND_Z standard errors (the two fits' in quadrature) from the whole band's.
+OFFSET_BAND_SHARE = 0.5
+OFFSET_BAND_Z = 4.0
+
+
+def _offset_by_band(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
+                    off: cand.OffsetTest) -> str:
+    """Why the accelerometer position the force mismatches read, on a recording whose
+    accelerometer was carried to the c.g. from the metadata's position, is not a rigid offset,
+    '' when it may be: its best-determined component low-passed at :data:`OFFSET_BAND_SHARE`
+    of the common cut-off lies :data:`OFFSET_BAND_Z` standard errors or more from the whole
+    band's (:func:`candidates.accelerometer_offset`). The rotational terms of a sensor at r are
+    a linear function of the rates, which filtering both sides keeps; motion the gyros carry
+    and the accelerometer does not feel — a structural mode inside the band, which the carry
+    puts into a_z times the arm — grows with frequency. (Asked only after a carry: without one
+    a true position read off a propeller aircraft's force mismatch, beside its unrecorded
+    thrust's own mismatch, drifts by band too — two probe c172p's, 6.6 and 5.6 ft ahead, read
+    2.2 and 2.9 ft, which the test would have withheld.) A probe's T-37 (25 Hz, a 4.5 Hz mode in q
+    and a_z inside the 6.1 Hz cut-off, the accelerometer 5.3 ft aft and 1.7 ft below the c.g.
+    in the metadata) read the position 4.79 ± 0.13 ft from it in the whole band, 2.05 ± 0.27
+    below 3 Hz and −0.18 ± 0.56 below 1 Hz."""
+    i = int(np.argmax(np.abs(off.t)))
+    try:
+        low = cand.accelerometer_offset(p, mismatch, noise, OFFSET_BAND_SHARE * p.common_cutoff_hz)
+    except (SingularRegressorsError, np.linalg.LinAlgError, ValueError):
+        return ""
+    spread = float(np.hypot(low.std_error_ft[i], off.std_error_ft[i]))
+    if not (np.isfinite(spread) and spread > 0):
+        return ""
+    z = abs(low.position_ft[i] - off.position_ft[i]) / spread
+    if z < OFFSET_BAND_Z:
+        return ""
+    axis = "xyz"[i]
+    return (f"not named: not a rigid offset: its {axis} reads {off.position_ft[i]:.3g} ± {off.std_error_ft[i]:.2g} "
+            f"ft in the whole band and {low.position_ft[i]:.3g} ± {low.std_error_ft[i]:.2g} ft below "
+            f"{OFFSET_BAND_SHARE * p.common_cutoff_hz:.2g} Hz ({z:.1f} standard errors apart); motion the gyros "
+            "carry and the accelerometer does not feel (a structural mode) grows with frequency so")
 
 
 def delay_scans(p: Prepared, mismatch: dict[str, np.ndarray], aero: AeroAlong,
