@@ -115,19 +115,27 @@ def test_rate_derivatives_advanced_removes_a_half_step_euler_lag():
     assert np.max(np.abs(fixed.deriv["q"] - w * np.cos(w * t))[inner]) < 0.05 * lag
 
 
-def _sensor_error(path, column: str, error) -> None:
-    """Rewrite the script's CSV with ``error(t, x)`` in place of ``column`` (the way a recorder's
-    own fault would reach it: after the flight, before anyone reads it)."""
+def _rewritten(path, edit) -> None:
+    """Rewrite the script's CSV through ``edit(head, X)``, which changes the samples X (rows by
+    columns ``head``) in place; 8 significant digits, as the script writes them."""
     import csv
     with open(path, newline="") as fh:
         rows = list(csv.reader(fh))
     head, X = rows[0], np.array(rows[1:], dtype=float)
-    j = head.index(column)
-    X[:, j] = error(X[:, 0], X[:, j])
+    edit(head, X)
     with open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(head)
         writer.writerows([[f"{v:.8g}" for v in row] for row in X])
+
+
+def _sensor_error(path, column: str, error) -> None:
+    """Rewrite the script's CSV with ``error(t, x)`` in place of ``column`` (the way a recorder's
+    own fault would reach it: after the flight, before anyone reads it)."""
+    def edit(head, X):
+        j = head.index(column)
+        X[:, j] = error(X[:, 0], X[:, j])
+    _rewritten(path, edit)
 
 
 def _first_order_lag(t, x, tau=0.05):
@@ -472,22 +480,16 @@ def _accelerometer_ahead(path, x_ft: float) -> None:
     """Rewrite the script's CSV (degrees, g) as recorded by an accelerometer ``x_ft`` ahead of
     the c.g.: a_z less x·q̇/g, a_y plus x·ṙ/g (q̇ and ṙ from the recorded rates by a 0.2 s
     cubic Savitzky-Golay derivative, the gyros' noise mostly left out)."""
-    import csv
-
     from scipy.signal import savgol_filter
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    head, X = rows[0], np.array(rows[1:], dtype=float)
-    dt = X[1, 0] - X[0, 0]
-    window = max(int(round(0.2 / dt)) | 1, 5)
-    qdot, rdot = (savgol_filter(np.radians(X[:, head.index(c)]), window, 3, deriv=1, delta=dt)
-                  for c in ("q_dps", "r_dps"))
-    X[:, head.index("az_g")] -= x_ft * qdot / G0
-    X[:, head.index("ay_g")] += x_ft * rdot / G0
-    with open(path, "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(head)
-        writer.writerows([[f"{v:.8g}" for v in row] for row in X])
+
+    def edit(head, X):
+        dt = X[1, 0] - X[0, 0]
+        window = max(int(round(0.2 / dt)) | 1, 5)
+        qdot, rdot = (savgol_filter(np.radians(X[:, head.index(c)]), window, 3, deriv=1, delta=dt)
+                      for c in ("q_dps", "r_dps"))
+        X[:, head.index("az_g")] -= x_ft * qdot / G0
+        X[:, head.index("ay_g")] += x_ft * rdot / G0
+    _rewritten(path, edit)
 
 
 def test_an_accelerometer_ahead_of_the_cg_is_named_once(tmp_path, monkeypatch):
@@ -1031,22 +1033,16 @@ def _with_driven_mode(path, frequency_hz: float, damping: float, q_rms: float, a
     K·s/(s² + 2ζωs + ω²) on δe, scaled to ``q_rms`` (rad/s) and ``az_rms`` (g; negative: in
     opposite phase): a gyro and an accelerometer on a flexible airframe (before the recorder,
     as :func:`_sensor_error`)."""
-    import csv
-
     from scipy import signal
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    head, X = rows[0], np.array(rows[1:], dtype=float)
-    deg = "de_deg" in head  # the script's degree convention: angles in deg, rates in deg/s
-    t, de = X[:, 0], X[:, head.index("de_deg" if deg else "de_rad")]
-    w = 2 * np.pi * frequency_hz
-    y = signal.lsim(([1.0, 0.0], [1.0, 2 * damping * w, w * w]), de - de[0], t)[1]
-    for column, rms in (("q_dps" if deg else "q_rps", np.degrees(q_rms) if deg else q_rms), ("az_g", az_rms)):
-        X[:, head.index(column)] += y * rms / np.std(y)
-    with open(path, "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(head)
-        writer.writerows([[f"{v:.8g}" for v in row] for row in X])
+
+    def edit(head, X):
+        deg = "de_deg" in head  # the script's degree convention: angles in deg, rates in deg/s
+        t, de = X[:, 0], X[:, head.index("de_deg" if deg else "de_rad")]
+        w = 2 * np.pi * frequency_hz
+        y = signal.lsim(([1.0, 0.0], [1.0, 2 * damping * w, w * w]), de - de[0], t)[1]
+        for column, rms in (("q_dps" if deg else "q_rps", np.degrees(q_rms) if deg else q_rms), ("az_g", az_rms)):
+            X[:, head.index(column)] += y * rms / np.std(y)
+    _rewritten(path, edit)
 
 
 def test_a_driven_mode_names_no_gyro_error_from_its_quasi_static_part(tmp_path, monkeypatch):
