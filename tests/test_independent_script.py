@@ -492,19 +492,28 @@ def _accelerometer_ahead(path, x_ft: float) -> None:
     _rewritten(path, edit)
 
 
+def _cub_with_its_accelerometer_ahead(tmp_path, monkeypatch, x_ft: float, told_ft: float | None = None) -> dict:
+    """The package's J-3 Cub (1,734 ft / 118 ft/s, a stabilator 3-2-1-1, 50 Hz, twice the noise,
+    doublet validation) with its accelerometer ``x_ft`` ahead of the c.g. (the metadata saying
+    ``told_ft``, or the c.g.), diagnosed without the calibration."""
+    model = _package_xml("J3Cub")
+    _with_multisteps(monkeypatch)
+    rec, val = _pair(tmp_path, "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
+                     amplitude_deg=2.94)
+    for path in (rec, val):
+        _accelerometer_ahead(path, x_ft)
+        if told_ft is not None:
+            _accelerometer_told_at(path, told_ft)
+    return diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+
+
 def test_an_accelerometer_ahead_of_the_cg_is_named_once(tmp_path, monkeypatch):
     """The package's J-3 Cub (1,734 ft / 118 ft/s, a stabilator 3-2-1-1, 50 Hz, twice the
     noise, doublet validation) with its accelerometer 4 ft ahead of the c.g.: the force
     mismatch put it at 4.14 ± 0.25 ft (x_accelerometer) and the kinematics, corroborated on
     the coefficients, at 3.34 ± 0.31 (offset_x); both were named, two findings of one
     position. It is named once (sensor_rules.name_accelerometer_once), at the larger t."""
-    model = _package_xml("J3Cub")
-    _with_multisteps(monkeypatch)
-    rec, val = _pair(tmp_path, "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
-                     amplitude_deg=2.94)
-    for path in (rec, val):
-        _accelerometer_ahead(path, 4.0)
-    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    result = _cub_with_its_accelerometer_ahead(tmp_path, monkeypatch, 4.0)
     found = _found(result)
     assert [p for p, _ in found] == ["x_accelerometer"] and found[0][1] == pytest.approx(4.0, rel=0.25)
     twice = next(c for c in result["candidates"] if c["parameter"] == "offset_x")
@@ -1095,13 +1104,6 @@ def test_an_accelerometer_elsewhere_than_the_metadata_says_is_named_after_the_ca
     """The J-3 Cub of :func:`test_an_accelerometer_ahead_of_the_cg_is_named_once` with its
     accelerometer 8 ft ahead and the metadata saying 4 ft: carried from 4 ft, the rest, a rigid
     4 ft, reads the same in every band and is named."""
-    model = _package_xml("J3Cub")
-    _with_multisteps(monkeypatch)
-    rec, val = _pair(tmp_path, "J3Cub", 1734.0, 117.9, 158, 50.0, "3211_pitch", units="deg", noise=2.0,
-                     amplitude_deg=2.94)
-    for path in (rec, val):
-        _accelerometer_ahead(path, 8.0)
-        _accelerometer_told_at(path, 4.0)
-    result = diagnose(model, rec, tmp_path / "out", val, calibrate=False)
+    result = _cub_with_its_accelerometer_ahead(tmp_path, monkeypatch, 8.0, told_ft=4.0)
     found = _found(result)
     assert [p for p, _ in found] == ["x_accelerometer"] and found[0][1] == pytest.approx(4.0, rel=0.25)
