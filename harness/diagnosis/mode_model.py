@@ -329,14 +329,14 @@ def withhold_sensor_errors_a_mode_makes(findings: list, p: Prepared) -> list:
         if f.effect == "structural_mode" and f.details.get("mode_model"):
             for c, x in mode_outputs(DrivenMode.from_dict(f.details["mode_model"]), p).items():
                 outputs[c] = outputs.get(c, 0.0) + x
-    suspects = [f for f in findings if f.effect in MODE_SENSOR_EFFECTS and _channel_of(f) & set(outputs)]
+    suspects = {id(f) for f in findings if f.effect in MODE_SENSOR_EFFECTS and _channel_of(f) & set(outputs)}
     if not suspects:
         return findings
     kin = plausible_kinematic_check(replace(p, raw=p.raw | {c: p.raw[c] - x for c, x in outputs.items()}))
     kept = []
     for f in findings:
-        found = kinematic_estimate(kin, f.parameter) if f in suspects else None
-        if f in suspects and (found is None or found[1] < T_IN):
+        found = kinematic_estimate(kin, f.parameter) if id(f) in suspects else None
+        if id(f) in suspects and (found is None or found[1] < T_IN):
             t = 0.0 if found is None else found[1]
             f.selected = False
             f.reason = (f"not named: with the named mode's output taken out of {', '.join(sorted(outputs))} the "

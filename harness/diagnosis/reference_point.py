@@ -52,6 +52,7 @@ from scipy.signal import detrend
 
 from estimators.colored_stepwise import colored_fit
 from harness.diagnosis.along import interior, model_along
+from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.prepare import Prepared, filtered_noise_std
 from models.aircraft import Aircraft, reference_point_alternative, reference_point_text
 from models.constants import G0_FPS2
@@ -222,7 +223,7 @@ def choose_reference_point(p: Prepared, aircraft: Aircraft, ic: InitialCondition
                            f"recording flown with it {there} shows a moment-reference offset")
 
 
-def withhold_shift_between_placements(cands: list, reference: ReferenceChoice | None) -> None:
+def withhold_shift_between_placements(cands: list[Candidate], reference: ReferenceChoice | None) -> None:
     """Deselect a moment-reference shift when the recording's moments put the reference point
     between the placements (:attr:`ReferenceChoice.between`): the placement is itself what a
     shift measures, and the shift named is then the distance to the nearer placement, which

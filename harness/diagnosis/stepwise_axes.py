@@ -299,7 +299,7 @@ def withhold_stiffness_a_shift_makes(cands: list[Candidate], step: StepwiseFits,
     0.16 ft from the model's had the stepwise's shift refuted by its wrong sign (its C_Z column
     shared with the α one), and the C_m,α change of +0.32 (a 0.15 ft shift) named in its place
     while C_m's constant said 0.24 ft."""
-    sel, by_key = step.selections.get("Cm", (None, {}))
+    _, by_key = step.selections.get("Cm", (None, {}))
     inner = interior(p)
     cbar = p.meta["geometry"]["cbar_ft"]
     cz = measured["CZ"][inner] - np.mean(measured["CZ"][inner])
