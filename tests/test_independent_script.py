@@ -1100,6 +1100,53 @@ def test_a_mode_the_carry_puts_into_a_z_is_not_read_as_the_accelerometer_s_posit
     assert "not a rigid offset" in offset["reason"], offset["reason"]
 
 
+def test_a_mode_a_quiet_record_keeps_as_motion_is_named_and_nothing_beside_it(tmp_path):
+    """The probe's seed 3518 (tests/probe/gen.py): a noise-free A-4 (9,100 ft / 659 ft/s,
+    three-axis multisine at 100 Hz) with a 9.4 Hz mode driven by the stabilator in q and a_z.
+    The common filter keeps everything to 37 Hz on a noise-free record, so the search above
+    three times that found no band and the mode was missed; its in-band part was read as an α
+    scale of −0.081 (t −8.6). The search takes the motion to end at 3 Hz
+    (spectra.RIGID_BODY_CUTOFF_HZ) and names the mode; with its output taken out of q and a_z
+    the kinematics no longer take the α scale (mode_model.withhold_sensor_errors_a_mode_makes)."""
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3518", str(tmp_path)],
+                   check=True, capture_output=True)
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert truth["aircraft"] == "A4" and truth["effect"] == "structural_mode" and truth["noise_factor"] == 0.0
+    # calibrated, as the command line does: the in-band mode a 37 Hz filter keeps in a_z and q̇ also
+    # enters as C_X,α and C_m,δe, which the loop sizes at nothing and withdraws
+    result = diagnose(_package_xml("A4"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
+                      calibrate_workers=1)
+    found = _found(result)
+    assert [p for p, _ in found] == ["mode_frequency_hz"]
+    assert found[0][1] == pytest.approx(truth["truth"], rel=0.02)
+    scale = next(c for c in result["candidates"] if c["parameter"] == "scale_alpha")
+    assert "mode's output taken out" in scale["reason"], scale["reason"]
+
+
+def test_a_vane_the_accelerometers_position_makes_is_not_named(tmp_path):
+    """The probe's seed 3632 (tests/probe/gen.py): a c182 (5,200 ft / 173 ft/s, pitch sweep at
+    50 Hz, mass channels with fuel burn, columns shuffled) with its accelerometer 8.8 ft ahead of
+    the c.g. The force mismatch named the position (6.7 ± 0.3 ft) and the kinematics, whose α
+    equation integrates the q̇·x/g in a_z into q·x/V, a vane 8.8 ft behind beside it (t −11.3).
+    With the accelerometer at the named position the kinematics no longer take the vane
+    (accelerometer_rules.withhold_vane_an_accelerometer_makes)."""
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3632", str(tmp_path)],
+                   check=True, capture_output=True)
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert truth["aircraft"] == "c182" and truth["parameter"] == "x_accelerometer"
+    result = diagnose(_package_xml("c182"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
+                      calibrate=False)
+    found = _found(result)
+    assert [p for p, _ in found] == ["x_accelerometer"]
+    assert found[0][1] == pytest.approx(truth["truth"], rel=0.25)
+    vane = next(c for c in result["candidates"] if c["parameter"] == "vane_alpha_x")
+    assert "integrates into a vane" in vane["reason"], vane["reason"]
+
+
 def test_an_accelerometer_elsewhere_than_the_metadata_says_is_named_after_the_carry(tmp_path, monkeypatch):
     """The J-3 Cub of :func:`test_an_accelerometer_ahead_of_the_cg_is_named_once` with its
     accelerometer 8 ft ahead and the metadata saying 4 ft: carried from 4 ft, the rest, a rigid

@@ -11,11 +11,15 @@ from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along, undriven_inertial
 from harness.diagnosis.evidence import Candidate
+from harness.diagnosis.kinematics import T_IN as KIN_T_IN
+from harness.diagnosis.kinematics import KinematicResult
 from harness.diagnosis.prepare import Prepared, interior_slice
+from harness.diagnosis.sensor_rules import kinematic_estimate, plausible_kinematic_check
 from harness.diagnosis.term_rules import left_impractical, term_change
 
 __all__ = ["KINEMATIC_POSITIONS", "note_refuted_positions", "refuted_positions", "term_beside_the_position",
-           "withhold_beside_the_accelerometer", "withhold_the_positions_rival", "withhold_through_the_inertial_angles"]
+           "withhold_beside_the_accelerometer", "withhold_the_positions_rival", "withhold_through_the_inertial_angles",
+           "withhold_vane_an_accelerometer_makes"]
 
 
 # The kinematic check's accelerometer position components (effects.md's sensor_offset).
@@ -200,3 +204,33 @@ def withhold_through_the_inertial_angles(cands: list[Candidate], selections: dic
         c.reason = (f"entered, but not named: the accelerometer position named ({named.estimate:.2f} ft) reaches "
                     f"{c.channel} through the inertial angle the model follows, integrated from the accelerometers, "
                     f"and accounts for {part:.2g} of this change of {abs(change):.3g}")
+
+
+def withhold_vane_an_accelerometer_makes(cands: list[Candidate], kin: KinematicResult, recorded: Prepared,
+                                         applied: dict[str, float]) -> None:
+    """Withhold an α vane's position (the kinematics' ``vane_alpha_x``) named beside an
+    accelerometer position the force mismatch named (``x_accelerometer``) when, the recording
+    as made (``recorded``) taken with the accelerometer at that position (the kinematic
+    ``offset_x``) and the other ``applied`` corrections, the kinematics no longer take the vane
+    at their entry t (:data:`kinematics.T_IN`). An accelerometer x ahead of the c.g. reads
+    q̇·x/g in a_z, which the α equation integrates to q·x/V: exactly a vane x behind the c.g.
+    The force mismatch tells the two apart (a vane leaves a_z alone); the α equation cannot.
+    A probe's c182 (5,200 ft / 173 ft/s, pitch sweep at 50 Hz, mass channels) with its
+    accelerometer 8.8 ft ahead had the position named at 6.7 ± 0.3 ft and beside it a vane
+    8.8 ± 0.8 ft behind (t −11.3; probe seed 3632)."""
+    accel = next((c for c in cands if c.selected and c.parameter == "x_accelerometer"), None)
+    vane = next((c for c in cands if c.selected and c.parameter == "vane_alpha_x"), None)
+    if accel is None or vane is None or "offset_x" not in kin.parameters or "offset_x" in applied:
+        return
+    others = {k: v for k, v in applied.items() if k != "vane_alpha_x"}
+    found = kinematic_estimate(plausible_kinematic_check(corrected_recording(recorded, kin, others | {
+        "offset_x": accel.estimate})), "vane_alpha_x")
+    if found is not None and found[1] >= KIN_T_IN:
+        return
+    vane.selected = False
+    vane.details["sensor_rival"] = "x_accelerometer"
+    t = 0.0 if found is None else found[1]
+    vane.reason = (f"not named: with the accelerometer at the position the force mismatch names "
+                   f"({accel.estimate:.2f} ft) the kinematics stand it at t = {t:.1f}, under their entry t of "
+                   f"{KIN_T_IN:g}; an accelerometer ahead of the c.g. reads q̇·x/g in a_z, which the α equation "
+                   f"integrates into a vane behind it (it had been: {vane.reason})")

@@ -6,7 +6,8 @@ import numpy as np
 
 from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refuted_positions,
                                                    withhold_beside_the_accelerometer, withhold_the_positions_rival,
-                                                   withhold_through_the_inertial_angles)
+                                                   withhold_through_the_inertial_angles,
+                                                   withhold_vane_an_accelerometer_makes)
 from harness.diagnosis.airspeed_rules import withhold_on_the_airspeed
 from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
 from harness.diagnosis.delay_rules import name_the_delay_the_terms_imitate
@@ -187,6 +188,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             withhold_imitated_by_named(cands, imitated, set(sensor_values))
             withhold_delays_imitated_by_named(cands, kin, p, aircraft, ic, aero.derivatives, noise, set(sensor_values))
     name_accelerometer_once(cands)
+    withhold_vane_an_accelerometer_makes(cands, kin, recorded, sensor_values)
     withhold_through_the_inertial_angles(cands, step.selections, p, kin, aircraft, ic, mismatch, sensor_values)
     # 6. spectra and gusts
     peak = structural_peak(p)

@@ -9,6 +9,7 @@ import numpy as np
 from scipy import ndimage, signal, stats
 
 from estimators.colored_stepwise import colored_fit
+from estimators.smoothing import sine_series_filter
 from harness.diagnosis.prepare import Prepared, interior_slice
 from models.constants import SURFACES
 
@@ -27,6 +28,15 @@ MODE_DRIVERS = {"q": ("de",), "ax": ("de",), "az": ("de",), "p": ("da", "dr"), "
 # the mode too at this level (:func:`peak_at`: three ordinates at a frequency given in advance).
 MODE_CONFIRM_P = 0.01
 GUST_HIGHPASS_HZ = 0.05  # the gust estimate drops what sensor-bias drift puts below this
+# The highest cut-off the mode search takes a record's motion to end at. The common filter's
+# cut-off is where the record's signal meets its noise: on a quiet record (a noise-free one
+# reaches 37 Hz) that keeps a 9 Hz mode as motion, and its in-band part was then read as an α
+# scale (an A-4 at 100 Hz, probe seed 3518, 7 Dec 2026). Rigid-body modes of full-scale
+# aircraft lie below about 1.2 Hz, and the best smoothing cut-off lies about 0.5 Hz above a
+# signal's band (Morelli, Practical Aspects of the Equation-Error Method, Eq. 18 and the
+# smoothing section); 3 Hz leaves room for a light aircraft's roll mode and an actuator's
+# roll-off, and puts the search from 9 Hz (three times it) at the latest.
+RIGID_BODY_CUTOFF_HZ = 3.0
 
 
 @dataclass(frozen=True)
@@ -58,9 +68,9 @@ def welch_dof(n: int, nperseg: int) -> float:
 
 def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
                     half_width_hz: float = 2.5) -> PeakTest | None:
-    """The most significant peak in what the recording's common filter leaves of each rate
-    and acceleration channel, above ``f_min_hz`` and three times the filter's cut-off (where
-    the maneuver itself has little power).
+    """The most significant peak in what the motion leaves of each rate and acceleration
+    channel (:func:`mode_residual`), above :func:`search_floor_hz` (``f_min_hz`` or three
+    times the motion's cut-off, where the maneuver itself has little power).
 
     The spectrum is Welch's (Hann, ``segment_s`` segments, 50 % overlap): averaging makes a
     lightly damped mode, rung by each input and decaying within a second or two, a peak a
@@ -80,11 +90,11 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
     for c in MODE_CHANNELS:
         if c not in p.raw:
             continue
-        x = p.raw[c] - p.smooth[c]
+        x = mode_residual(p, c)
         f, P, med, w = _median_spectrum(x, fs, nper, half_width_hz)
         df = f[1] - f[0]
         # the top 10 % below Nyquist is left out: the median window is one-sided there
-        band = (f >= max(f_min_hz, 3.0 * p.common_cutoff_hz)) & (f <= 0.9 * f[-1])
+        band = (f >= search_floor_hz(p, f_min_hz)) & (f <= 0.9 * f[-1])
         if band.sum() < 2 * w:
             continue
         idx = np.flatnonzero(band & local_maxima(P))
@@ -118,7 +128,7 @@ def peak_at(p: Prepared, channel: str, frequency_hz: float, segment_s: float = 2
     fs = 1.0 / p.dt
     nper = int(round(segment_s * fs))
     dof = welch_dof(p.n, nper)
-    f, P, med, _ = _median_spectrum(p.raw[channel] - p.smooth[channel], fs, nper, half_width_hz)
+    f, P, med, _ = _median_spectrum(mode_residual(p, channel), fs, nper, half_width_hz)
     k = int(np.argmin(np.abs(f - frequency_hz)))
     near = np.arange(max(k - 1, 0), min(k + 2, f.size))
     ratios = P[near] / np.maximum(med[near], 1e-300)
@@ -148,7 +158,7 @@ def predicted_peak_p(p: Prepared, pv: Prepared, channel: str, frequency_hz: floa
 
     def spectrum(r: Prepared, c: str):
         nper = int(round(segment_s / r.dt))
-        f, P, med, _ = _median_spectrum(r.raw[c] - r.smooth[c], 1.0 / r.dt, nper, half_width_hz)
+        f, P, med, _ = _median_spectrum(mode_residual(r, c), 1.0 / r.dt, nper, half_width_hz)
         k = int(np.argmin(np.abs(f - frequency_hz)))
         near = slice(max(k - 1, 0), min(k + 2, f.size))
         return P[near], med[near], float(np.median(P[(f >= 0.7 * f[-1]) & (f <= 0.9 * f[-1])]))
@@ -177,15 +187,39 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
         return f"it does not record {channel}"
     if p.n < 4 * int(round(segment_s * fs)):
         return f"it is shorter than {4 * segment_s:g} s"
-    low = max(f_min_hz, 3.0 * p.common_cutoff_hz)
+    low = search_floor_hz(p, f_min_hz)
+    cut = motion_cutoff_hz(p)
     if low >= 0.45 * fs:
-        return (f"it has no spectral band to search: three times its common filter's cut-off of "
-                f"{p.common_cutoff_hz:.1f} Hz lies above 0.9 of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping "
-                "everything below as motion")
+        return (f"it has no spectral band to search: three times its motion's cut-off of {cut:.1f} Hz lies above 0.9 "
+                f"of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping everything below as motion")
     if not low <= frequency_hz <= 0.9 * 0.5 * fs:
-        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or three times its common "
-                f"filter's cut-off of {p.common_cutoff_hz:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
+        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or three times its motion's "
+                f"cut-off of {cut:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
     return ""
+
+
+def motion_cutoff_hz(p: Prepared) -> float:
+    """Where the mode search takes record ``p``'s motion to end: its common filter's cut-off,
+    at most :data:`RIGID_BODY_CUTOFF_HZ`."""
+    return min(p.common_cutoff_hz, RIGID_BODY_CUTOFF_HZ)
+
+
+def search_floor_hz(p: Prepared, f_min_hz: float = 2.0) -> float:
+    """The lowest frequency the mode search looks at: ``f_min_hz`` or three times
+    :func:`motion_cutoff_hz`, whichever is higher (the maneuver itself has little power
+    there)."""
+    return max(f_min_hz, 3.0 * motion_cutoff_hz(p))
+
+
+def mode_residual(p: Prepared, channel: str) -> np.ndarray:
+    """What the motion leaves of ``channel``: the record less its common filter's output, that
+    filter's sine-series weights cut at :func:`motion_cutoff_hz` (unchanged where the common
+    cut-off lies below it)."""
+    if p.common_cutoff_hz <= RIGID_BODY_CUTOFF_HZ:
+        return p.raw[channel] - p.smooth[channel]
+    k = np.arange(1, p.weights.size + 1)
+    weights = np.where(k / (2.0 * p.t[-1]) <= RIGID_BODY_CUTOFF_HZ, p.weights, 0.0)
+    return p.raw[channel] - sine_series_filter(p.raw[channel], weights)
 
 
 def _median_spectrum(x: np.ndarray, fs: float, nper: int,
@@ -210,7 +244,7 @@ def input_lines(p: Prepared, nper: int, dof: float, half_width_hz: float) -> dic
     for s in SURFACES:
         if s not in p.raw:
             continue
-        f, P, med, _ = _median_spectrum(p.raw[s] - p.smooth[s], fs, nper, half_width_hz)
+        f, P, med, _ = _median_spectrum(mode_residual(p, s), fs, nper, half_width_hz)
         idx = np.flatnonzero(local_maxima(P))
         ratio = P[idx] / np.maximum(med[idx], 1e-300)
         line = np.zeros(f.size)
