@@ -274,8 +274,12 @@ def delay_scan(p: Prepared, surface: str, mismatch: dict[str, np.ndarray], deriv
     """Scan a transport delay τ of ``surface``: the model then sees δ(t − τ), so its
     coefficients change by C_δ·(δ(t − τ) − δ(t)); τ̂ minimises the noise-weighted mismatch
     over the axes the surface drives. Its standard error is the colored-residual one of
-    the linearised column −C_δ δ̇(t − τ̂)."""
-    if surface not in p.smooth or surface not in p.excited:
+    the linearised column −C_δ δ̇(t − τ̂). A surface is scanned when it moved
+    (``p.driven``: its filtered signal clear of the noise the filter passes, not only its
+    samples 5 times their noise): a probe's F-16 (27,400 ft / 716 ft/s, a 1° stabilator sweep
+    whose sensor noise was 0.2°) with a 96 ms stabilator delay had no scan of it (probe seed
+    3637)."""
+    if surface not in p.smooth or surface not in p.driven:
         return None
     axes = [c for c in SURFACE_AXES[surface] if abs(derivatives.get(f"{c}_{surface}", 0.0)) > 0]
     if not axes:

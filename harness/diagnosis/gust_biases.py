@@ -16,8 +16,10 @@ from harness.diagnosis.sensor_rules import kinematic_estimate
 from harness.diagnosis.spectra import GustEstimate
 
 
-# The kinematic scale factors corrected with the biases before the gust test is asked again.
+# The kinematic scale factors and instrument positions corrected with the biases before the
+# gust test is asked again.
 VANE_SCALES = ("scale_alpha", "scale_beta")
+POSITIONS = ("offset_x", "offset_y", "offset_z", "vane_alpha_x", "vane_beta_x")
 
 
 def gusts_without_biases(p: Prepared, kin: KinematicResult, V0: float) -> tuple[GustEstimate, dict[str, float]] | None:
@@ -36,9 +38,14 @@ def gusts_without_biases(p: Prepared, kin: KinematicResult, V0: float) -> tuple[
     vane's own angle, it takes only the part of the residual that follows that angle. (A
     c172x in a 3-2-1-1 on each axis at 163 ft/s with its β vane reading 15 % high read light
     turbulence, the side 'gust' following β, and named it; the scale the kinematics put at
-    0.156, t 16, was not applied.)"""
+    0.156, t 16, was not applied.) So is an instrument's position off the c.g.
+    (:data:`POSITIONS`): fixed, it takes only the part that follows the rates and their
+    derivatives (a probe's c172x, lateral sweeps at 166 ft/s, with its accelerometer 9.5 ft
+    left of the c.g. read light gusts of 1.2 ft/s, the 'gust' the ṗ·y it puts in a_z
+    integrates to, and the position the kinematics put at −10.0 ft, t −19.9, was not applied;
+    probe seed 3592)."""
     biases = {}
-    for name in kin.forced + tuple(n for n in kin.selection.names if n in VANE_SCALES):
+    for name in kin.forced + tuple(n for n in kin.selection.names if n in VANE_SCALES + POSITIONS):
         found = kinematic_estimate(kin, name)
         if found is not None and found[1] >= KIN_T_IN and is_plausible(name, found[0], V0):
             biases[name] = found[0]

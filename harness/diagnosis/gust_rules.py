@@ -266,14 +266,16 @@ NOT_IN_GUSTS = ("not named: in turbulence the aerodynamics see air-relative rate
 
 def withhold_in_turbulence(cands: list[Candidate]) -> None:
     """In turbulence, deselect every term fitted to the coefficient mismatch (aerodynamic
-    terms, control delays, the accelerometer position from the force mismatch): the gust's
-    rotational components are unmeasured regressors, correlated with α, α̇ and the rates
-    (a Dryden pitch gust follows the derivative of the vertical gust), so the equation-error
-    fit is biased there. The outside sweep's turbulent nulls named C_Z,α, C_Z,δe, C_m,α and a
-    moment-reference shift at |t| 5-10 before this rule."""
+    terms, control delays, the accelerometer position from the force mismatch, a
+    moment-reference shift however it was read): the gust's rotational components are
+    unmeasured regressors, correlated with α, α̇ and the rates (a Dryden pitch gust follows
+    the derivative of the vertical gust), so the equation-error fit is biased there. The
+    outside sweep's turbulent nulls named C_Z,α, C_Z,δe, C_m,α and a moment-reference shift
+    at |t| 5-10 before this rule; a probe's F-16 (11,000 ft / 643 ft/s, three-axis sweeps,
+    Dryden light) had a shift of 0.055 ± 0.004 ft read off C_m's mistrim (probe seed 3611)."""
     for c in cands:
         if c.selected and (c.test.startswith("stepwise") or c.test.startswith("delay scan")
-                           or c.parameter == "x_accelerometer"):
+                           or c.parameter == "x_accelerometer" or c.effect == "cg_offset"):
             c.selected = False
             c.reason = NOT_IN_GUSTS
 
