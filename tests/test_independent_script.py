@@ -20,6 +20,31 @@ def _found(result):
     return [(f["parameter"], round(f["estimate"], 4)) for f in result["findings"] if f["effect"] != "none"]
 
 
+def _probe(seed: int, folder: Path) -> dict:
+    """Fly the kept probe's draw ``seed`` (tests/probe/gen.py: jsbsim and numpy only) into
+    ``folder`` (id.csv, val.csv and their metadata) and return its truth.json."""
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), str(seed), str(folder)],
+                   check=True, capture_output=True)
+    return json.loads((folder / "truth.json").read_text())
+
+
+def _diagnosed_probe(seed: int, folder: Path, validation: bool = True, **options) -> tuple[dict, dict]:
+    """The kept probe's draw ``seed`` (:func:`_probe`) and its diagnosis against its own aircraft."""
+    truth = _probe(seed, folder)
+    result = diagnose(_package_xml(truth["aircraft"]), folder / "id.csv", folder / "out",
+                      folder / "val.csv" if validation else None, **options)
+    return truth, result
+
+
+def _named_alone(result: dict, truth: dict, rel: float = 0.25) -> None:
+    """The planted parameter is the only finding, its size within ``rel`` of the truth."""
+    found = _found(result)
+    assert [p for p, _ in found] == [truth["parameter"]], found
+    assert found[0][1] == pytest.approx(truth["truth"], rel=rel)
+
+
 def _placement(result):
     return next((a["stood_in_by"] for a in result["assumptions"] if a["item"] == "aerodynamic reference point"), "")
 
@@ -1087,14 +1112,8 @@ def test_a_mode_the_carry_puts_into_a_z_is_not_read_as_the_accelerometer_s_posit
     accelerometer 4.8 ft from where the metadata put it (t 38). The position it reads grows
     with the band (2.2 ± 0.3 ft below 3 Hz); a rigid offset does not
     (stepwise_axes._offset_by_band): not named."""
-    import subprocess
-    import sys
-    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3454", str(tmp_path)],
-                   check=True, capture_output=True)
-    truth = json.loads((tmp_path / "truth.json").read_text())
+    truth, result = _diagnosed_probe(3454, tmp_path, calibrate=False)
     assert truth["aircraft"] == "T37" and truth["effect"] == "structural_mode"
-    result = diagnose(_package_xml("T37"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
-                      calibrate=False)
     assert "x_accelerometer" not in [p for p, _ in _found(result)]
     offset = next(c for c in result["candidates"] if c["parameter"] == "x_accelerometer")
     assert "not a rigid offset" in offset["reason"], offset["reason"]
@@ -1108,19 +1127,11 @@ def test_a_mode_a_quiet_record_keeps_as_motion_is_named_and_nothing_beside_it(tm
     scale of −0.081 (t −8.6). The search takes the motion to end at 3 Hz
     (spectra.RIGID_BODY_CUTOFF_HZ) and names the mode; with its output taken out of q and a_z
     the kinematics no longer take the α scale (mode_model.withhold_sensor_errors_a_mode_makes)."""
-    import subprocess
-    import sys
-    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3518", str(tmp_path)],
-                   check=True, capture_output=True)
-    truth = json.loads((tmp_path / "truth.json").read_text())
-    assert truth["aircraft"] == "A4" and truth["effect"] == "structural_mode" and truth["noise_factor"] == 0.0
     # calibrated, as the command line does: the in-band mode a 37 Hz filter keeps in a_z and q̇ also
     # enters as C_X,α and C_m,δe, which the loop sizes at nothing and withdraws
-    result = diagnose(_package_xml("A4"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
-                      calibrate_workers=1)
-    found = _found(result)
-    assert [p for p, _ in found] == ["mode_frequency_hz"]
-    assert found[0][1] == pytest.approx(truth["truth"], rel=0.02)
+    truth, result = _diagnosed_probe(3518, tmp_path, calibrate_workers=1)
+    assert truth["aircraft"] == "A4" and truth["effect"] == "structural_mode" and truth["noise_factor"] == 0.0
+    _named_alone(result, truth, rel=0.02)
     scale = next(c for c in result["candidates"] if c["parameter"] == "scale_alpha")
     assert "mode's output taken out" in scale["reason"], scale["reason"]
 
@@ -1132,17 +1143,9 @@ def test_a_vane_the_accelerometers_position_makes_is_not_named(tmp_path):
     equation integrates the q̇·x/g in a_z into q·x/V, a vane 8.8 ft behind beside it (t −11.3).
     With the accelerometer at the named position the kinematics no longer take the vane
     (accelerometer_rules.withhold_vane_an_accelerometer_makes)."""
-    import subprocess
-    import sys
-    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3632", str(tmp_path)],
-                   check=True, capture_output=True)
-    truth = json.loads((tmp_path / "truth.json").read_text())
+    truth, result = _diagnosed_probe(3632, tmp_path, calibrate=False)
     assert truth["aircraft"] == "c182" and truth["parameter"] == "x_accelerometer"
-    result = diagnose(_package_xml("c182"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
-                      calibrate=False)
-    found = _found(result)
-    assert [p for p, _ in found] == ["x_accelerometer"]
-    assert found[0][1] == pytest.approx(truth["truth"], rel=0.25)
+    _named_alone(result, truth)
     vane = next(c for c in result["candidates"] if c["parameter"] == "vane_alpha_x")
     assert "integrates into a vane" in vane["reason"], vane["reason"]
 
@@ -1154,16 +1157,9 @@ def test_a_delay_on_a_surface_whose_samples_are_noisy_is_scanned(tmp_path):
     and the delay went unseen (C_m,α̇ entered in its place); its filtered signal stands clear of
     the noise the filter passes (prepare.maneuver_driven), and the scan finds the delay. (The
     validation 3-2-1-1, 0.3° on the stabilator, cannot confirm it: left out here.)"""
-    import subprocess
-    import sys
-    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3637", str(tmp_path)],
-                   check=True, capture_output=True)
-    truth = json.loads((tmp_path / "truth.json").read_text())
+    truth, result = _diagnosed_probe(3637, tmp_path, validation=False, calibrate=False)
     assert truth["aircraft"] == "f16" and truth["parameter"] == "tau_de"
-    result = diagnose(_package_xml("f16"), tmp_path / "id.csv", tmp_path / "out", calibrate=False)
-    found = _found(result)
-    assert [p for p, _ in found] == ["tau_de"]
-    assert found[0][1] == pytest.approx(truth["truth"], rel=0.25)
+    _named_alone(result, truth)
 
 
 def test_gusts_an_accelerometer_position_makes_do_not_void_it(tmp_path):
@@ -1172,17 +1168,9 @@ def test_gusts_an_accelerometer_position_makes_do_not_void_it(tmp_path):
     in a_z integrates to a 'gust' of 1.2 ft/s, and light gusts voided the sensor tests: the
     position the kinematics put at −10.0 ft (t −19.9) was not applied and nothing was named. On
     the channels corrected for it (gust_biases.POSITIONS) there are no gusts, and it is named."""
-    import subprocess
-    import sys
-    subprocess.run([sys.executable, str(Path(__file__).parent / "probe" / "gen.py"), "3592", str(tmp_path)],
-                   check=True, capture_output=True)
-    truth = json.loads((tmp_path / "truth.json").read_text())
+    truth, result = _diagnosed_probe(3592, tmp_path, calibrate=False)
     assert truth["aircraft"] == "c172x" and truth["parameter"] == "offset_y"
-    result = diagnose(_package_xml("c172x"), tmp_path / "id.csv", tmp_path / "out", tmp_path / "val.csv",
-                      calibrate=False)
-    found = _found(result)
-    assert [p for p, _ in found] == ["offset_y"]
-    assert found[0][1] == pytest.approx(truth["truth"], rel=0.25)
+    _named_alone(result, truth)
 
 
 def test_an_accelerometer_elsewhere_than_the_metadata_says_is_named_after_the_carry(tmp_path, monkeypatch):
