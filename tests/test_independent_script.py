@@ -1136,6 +1136,22 @@ def test_a_mode_a_quiet_record_keeps_as_motion_is_named_and_nothing_beside_it(tm
     assert "mode's output taken out" in scale["reason"], scale["reason"]
 
 
+def test_a_driven_mode_names_no_derivative_of_its_surface(tmp_path):
+    """The probe's seed 3680 (tests/probe/gen.py): an F-4N (24,700 ft / 545 ft/s, three-axis
+    sweeps at 40 Hz, q̇ recorded, the accelerometer's position in the metadata) with a 10.5 Hz
+    mode driven by the stabilator in q, a_x and a_z. The mode was named and beside it C_X,δe
+    −0.19 and C_m,δe −1.23 (t −11 and −8), the mode's quasi-static part below its resonance,
+    confirmed by the validation maneuver, which rang the same mode. With the mode's output
+    taken out of its channels the analysis names neither
+    (mode_model.withhold_terms_a_mode_makes)."""
+    truth, result = _diagnosed_probe(3680, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "F4N" and truth["effect"] == "structural_mode"
+    _named_alone(result, truth, rel=0.02)
+    for name in ("CX_de", "Cm_de"):
+        term = next(c for c in result["candidates"] if c["parameter"] == name)
+        assert "mode's output taken out" in term["reason"], term["reason"]
+
+
 def test_a_vane_the_accelerometers_position_makes_is_not_named(tmp_path):
     """The probe's seed 3632 (tests/probe/gen.py): a c182 (5,200 ft / 173 ft/s, pitch sweep at
     50 Hz, mass channels with fuel burn, columns shuffled) with its accelerometer 8.8 ft ahead of

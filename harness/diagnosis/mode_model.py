@@ -13,6 +13,7 @@ the mode, u the surface's Wiener estimate, with f and ζ found by variable proje
 gains solved linearly for each trial f, ζ)."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -314,6 +315,59 @@ def with_mode_band(p: Prepared, smooth: dict[str, np.ndarray], modes: list[Drive
 MODE_SENSOR_EFFECTS = ("sensor_scale", "sensor_time_skew", "sensor_offset")
 
 
+def modelled_mode_outputs(findings: list, p: Prepared) -> dict[str, np.ndarray]:
+    """The modelled modes' output (:func:`attach_mode_models`, :func:`mode_outputs`) over
+    maneuver ``p``, summed per channel."""
+    outputs: dict[str, np.ndarray] = {}
+    for m in driven_modes(findings):
+        for c, x in mode_outputs(m, p).items():
+            outputs[c] = outputs.get(c, 0.0) + x
+    return outputs
+
+
+def without_outputs(p: Prepared, outputs: dict[str, np.ndarray]) -> Prepared:
+    """Maneuver ``p`` with ``outputs`` taken out of its channels, smoothed and differentiated
+    again by its common filter."""
+    raw = p.raw | {c: p.raw[c] - x for c, x in outputs.items()}
+    smooth = p.smooth | {c: p.filt(raw[c]) for c in outputs}
+    deriv = p.deriv | {c: p.differentiate(raw[c]) for c in outputs}
+    return replace(p, raw=raw, smooth=smooth, deriv=deriv)
+
+
+# The tests whose terms are read off the coefficient mismatch (stepwise_axes, candidates).
+MISMATCH_TESTS = ("stepwise", "delay scan")
+
+
+def withhold_terms_a_mode_makes(findings: list, p: Prepared, reanalysed: Callable[[Prepared], object]) -> list:
+    """The findings less the terms read off the coefficient mismatch that the analysis of
+    maneuver ``p`` with a modelled mode's output taken out of its channels
+    (:func:`modelled_mode_outputs`, :func:`without_outputs`; ``reanalysed`` runs it and returns
+    its Analysis) no longer names; each one withheld is deselected with the reason. A mode
+    driven by a surface rings below its resonance too, in the rigid-body band, where q̇ and
+    the accelerations carry it into the measured moment and force coefficients as the
+    surface's own derivative: a probe's F-4N (24,700 ft / 545 ft/s, three-axis sweeps at
+    40 Hz, q̇ recorded) with a 10.5 Hz mode driven by the stabilator in q, a_x and a_z had the
+    mode named and beside it C_X,δe −0.19 and C_m,δe −1.23 (t −11 and −8), confirmed by the
+    validation maneuver, which rang the same mode (probe seed 3680)."""
+    terms = [f for f in findings if f.selected and f.test.startswith(MISMATCH_TESTS)]
+    outputs = modelled_mode_outputs(findings, p) if terms else {}
+    if not outputs:
+        return findings
+    again = {(c.channel, c.parameter): c for c in reanalysed(without_outputs(p, outputs)).candidates}
+    kept = []
+    for f in findings:
+        other = again.get((f.channel, f.parameter))
+        if f in terms and (other is None or not other.selected):
+            t = "not a candidate" if other is None else f"t = {other.t:.1f}, {other.reason}"
+            f.selected = False
+            f.reason = (f"not named: with the named mode's output taken out of {', '.join(sorted(outputs))} the "
+                        f"analysis no longer names it ({t}); the mode, driven by a surface, rings below its "
+                        f"resonance too (it had been: {f.reason})")
+            continue
+        kept.append(f)
+    return kept
+
+
 def withhold_sensor_errors_a_mode_makes(findings: list, p: Prepared) -> list:
     """The findings less the sensor errors (:data:`MODE_SENSOR_EFFECTS`) that the kinematics no
     longer take, at their entry t, with a modelled mode's output (:func:`attach_mode_models`)
@@ -327,15 +381,11 @@ def withhold_sensor_errors_a_mode_makes(findings: list, p: Prepared) -> list:
     asked too, its kinematics being built from those it does: a noise-free A-4 (9,100 ft /
     659 ft/s, 100 Hz) with a 9.4 Hz mode in q and a_z had an α scale of −0.081 (t −8.6)
     named beside it (probe seed 3518)."""
-    outputs = {}
-    for f in findings:
-        if f.effect == "structural_mode" and f.details.get("mode_model"):
-            for c, x in mode_outputs(DrivenMode.from_dict(f.details["mode_model"]), p).items():
-                outputs[c] = outputs.get(c, 0.0) + x
+    outputs = modelled_mode_outputs(findings, p)
     suspects = {id(f) for f in findings if f.effect in MODE_SENSOR_EFFECTS} if outputs else set()
     if not suspects:
         return findings
-    kin = plausible_kinematic_check(replace(p, raw=p.raw | {c: p.raw[c] - x for c, x in outputs.items()}))
+    kin = plausible_kinematic_check(without_outputs(p, outputs))
     kept = []
     for f in findings:
         found = kinematic_estimate(kin, f.parameter) if id(f) in suspects else None
