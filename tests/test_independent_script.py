@@ -1166,6 +1166,21 @@ def test_a_vane_the_accelerometers_position_makes_is_not_named(tmp_path):
     assert "integrates into a vane" in vane["reason"], vane["reason"]
 
 
+def test_an_undriven_gyro_s_noise_does_not_shrink_the_accelerometer_s_position(tmp_path):
+    """The probe's seed 3753 (tests/probe/gen.py): an F-15 (12,300 ft / 821 ft/s, pitch doublets
+    at 25 Hz, q̇ recorded) with its accelerometer 9.7 ft ahead of the c.g. The position's C_Y
+    column x·ṙ, built on the yaw gyro's differentiated noise, outweighed C_Z's q̇·x and read
+    the position at 2.4 ± 0.5 ft; C_Z,α and C_Z,δe changes were named in its place. With the
+    undriven rates at their means (candidates.accelerometer_columns) the force mismatch reads
+    10.2 ± 1.0 ft, which it cannot tell from a change of lift along α on this maneuver:
+    neither is named (a miss, not a false finding)."""
+    truth, result = _diagnosed_probe(3753, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "f15" and truth["parameter"] == "x_accelerometer" and truth["kind"] == "pitch"
+    assert _found(result) == []
+    position = next(c for c in result["candidates"] if c["parameter"] == "x_accelerometer")
+    assert position["estimate"] == pytest.approx(truth["truth"], abs=2.0 * position["std_error"])
+
+
 def test_a_delay_on_a_surface_whose_samples_are_noisy_is_scanned(tmp_path):
     """The probe's seed 3637 (tests/probe/gen.py): an F-16 (27,400 ft / 716 ft/s, three-axis
     sweeps at 40 Hz, noise twice flight test's) with a 96 ms stabilator delay. Its 1° sweep stands
