@@ -354,18 +354,21 @@ def withhold_terms_a_mode_makes(findings: list, p: Prepared, reanalysed: Callabl
     if not outputs:
         return findings
     again = {(c.channel, c.parameter): c for c in reanalysed(without_outputs(p, outputs)).candidates}
-    kept = []
-    for f in findings:
+    withheld = set()
+    for f in terms:
         other = again.get((f.channel, f.parameter))
-        if f in terms and (other is None or not other.selected):
-            t = "not a candidate" if other is None else f"t = {other.t:.1f}, {other.reason}"
-            f.selected = False
-            f.reason = (f"not named: with the named mode's output taken out of {', '.join(sorted(outputs))} the "
-                        f"analysis no longer names it ({t}); the mode, driven by a surface, rings below its "
-                        f"resonance too (it had been: {f.reason})")
-            continue
-        kept.append(f)
-    return kept
+        if other is None or not other.selected:
+            said = "not a candidate" if other is None else f"t = {other.t:.1f}, {other.reason}"
+            _withhold_for_the_mode(f, outputs, f"the analysis no longer names it ({said})")
+            withheld.add(id(f))
+    return [f for f in findings if id(f) not in withheld]
+
+
+def _withhold_for_the_mode(f, outputs: dict, said: str) -> None:
+    """Deselect finding ``f``, saying what ``said`` with the mode's ``outputs`` taken out."""
+    f.selected = False
+    f.reason = (f"not named: with the named mode's output taken out of {', '.join(sorted(outputs))} {said}; the "
+                f"mode, driven by a surface, rings below its resonance too (it had been: {f.reason})")
 
 
 def withhold_sensor_errors_a_mode_makes(findings: list, p: Prepared) -> list:
@@ -386,16 +389,12 @@ def withhold_sensor_errors_a_mode_makes(findings: list, p: Prepared) -> list:
     if not suspects:
         return findings
     kin = plausible_kinematic_check(without_outputs(p, outputs))
-    kept = []
+    withheld = set()
     for f in findings:
         found = kinematic_estimate(kin, f.parameter) if id(f) in suspects else None
         if id(f) in suspects and (found is None or found[1] < T_IN):
             t = 0.0 if found is None else found[1]
-            f.selected = False
-            f.reason = (f"not named: with the named mode's output taken out of {', '.join(sorted(outputs))} the "
-                        f"kinematics stand it at t = {t:.1f}, under their entry t; the mode, driven by a surface, "
-                        f"rings below its resonance too (it had been: {f.reason})")
-            continue
-        kept.append(f)
-    return kept
+            _withhold_for_the_mode(f, outputs, f"the kinematics stand it at t = {t:.1f}, under their entry t")
+            withheld.add(id(f))
+    return [f for f in findings if id(f) not in withheld]
 
