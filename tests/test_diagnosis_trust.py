@@ -508,6 +508,34 @@ def test_an_accelerometer_offset_is_explained_along_its_own_axis():
     assert _offset_direction("x_accelerometer", -5.0) == ("x", "behind")
 
 
+def test_the_accelerometer_columns_use_only_the_rates_the_maneuver_drove():
+    """candidates.accelerometer_columns: on a pitch maneuver (q driven, p and r not) x enters
+    C_Z as −q̇·x·m/(q̄S) with the undriven rates at their means, not their records (their
+    noise's derivative would pull x toward zero), and y, none of whose rates (ṗ, ṙ) moved,
+    is not fitted: its columns are zero."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from harness.diagnosis.candidates import accelerometer_columns
+    n, dt = 500, 0.02
+    t = np.arange(n) * dt
+    rng = np.random.default_rng(3)
+    q, qd = 0.1 * np.sin(2 * np.pi * t), 0.2 * np.pi * np.cos(2 * np.pi * t)
+    noisy = {g: 0.002 * rng.normal(size=n) for g in "pr"}
+    p = SimpleNamespace(n=n, driven=("de", "q", "alpha"), mass={"mass_slug": np.full(n, 2.0)},
+                        meta={"geometry": {"S_ft2": 10.0}},
+                        smooth={"p": noisy["p"], "q": q, "r": noisy["r"], "qbar": np.full(n, 100.0)},
+                        deriv={"p": np.gradient(noisy["p"], dt), "q": qd, "r": np.gradient(noisy["r"], dt)})
+    cols = accelerometer_columns(p)
+    scale = 2.0 / (100.0 * 10.0)
+    pm, rm = np.mean(noisy["p"]), np.mean(noisy["r"])
+    np.testing.assert_allclose(cols["x"]["CZ"], (-qd + pm * rm) * scale, atol=1e-12)  # −q̇x + p·r·x
+    np.testing.assert_allclose(cols["x"]["CY"], (pm * q) * scale, atol=1e-12)  # ṙ at zero: p·q·x only
+    assert not any(np.any(cols["y"][c]) for c in ("CX", "CY", "CZ"))
+    assert np.ptp(cols["z"]["CX"]) > 0  # q̇·z
+
+
 def test_an_accelerometer_at_the_position_the_metadata_give_is_carried_to_the_cg():
     """prepare.accelerometer_to_cg: an accelerometer r = (x, y, z) ft from the c.g. reads
     a + [ω̇ × r + ω × (ω × r)]/g₀; with the position in the metadata the c.g. readings come

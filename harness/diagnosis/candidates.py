@@ -346,8 +346,16 @@ def accelerometer_columns(p: Prepared) -> dict[str, dict[str, np.ndarray]]:
         r = np.zeros(3)
         r[i] = 1.0
         extra = (np.cross(wd, r) + np.cross(w, np.cross(w, r))) * m / (s["qbar"] * S)[:, None]
+        if not any(g in p.driven for g in POSITION_RATES[a]):  # nothing but the means: not fitted
+            extra = np.zeros_like(extra)
         out[a] = {"CX": extra[:, 0], "CY": extra[:, 1], "CZ": extra[:, 2]}
     return out
+
+
+# The rates whose motion shows each component of the accelerometer's position (ω̇ × r):
+# x through q̇ (a_z) and ṙ (a_y), y through ṗ and ṙ, z through ṗ and q̇. A component none of
+# whose rates the maneuver drove is not fitted (its columns would be the means' products only).
+POSITION_RATES = {"x": ("q", "r"), "y": ("p", "r"), "z": ("p", "q")}
 
 
 @dataclass(frozen=True)
