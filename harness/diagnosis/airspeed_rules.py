@@ -30,6 +30,14 @@ NORMALISED = ("phat", "qhat", "rhat")
 # The airspeed error probed for the signature, as a share of the airspeed (it is linear there).
 SIGNATURE_SHARE = 0.01
 
+# An airspeed error an instrument could make is within 10 % of V (kinematics.PLAUSIBLE's
+# airspeed scale) or within this, whichever is larger (ft/s, 10 kt): a light aircraft's
+# pitot-static position error at low speed alone reaches several knots (the Cessna 172S
+# Pilot's Operating Handbook's airspeed calibration, Section 5: 50 KIAS is 56 KCAS, flaps up).
+# A probe's J-3 Cub at 103 ft/s with V 11.9 ft/s high (11.5 %) had C_l,p̂ named −0.054
+# (t −45) in the error's place (probe seed 3859).
+AIRSPEED_ERROR_FLOOR_FPS = 16.9
+
 
 def normalised_by_airspeed(c: Candidate) -> bool:
     """Whether term ``c``'s regressor is a rate normalised by the airspeed (a rate derivative
@@ -59,7 +67,7 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
     (:func:`airspeed_signature`) in the term's place (with the axis's other selected terms and
     its nuisance columns); when the airspeed error so sized is one an instrument could make
     (within :data:`kinematics.PLAUSIBLE`'s 10 % of V for an airspeed scale, which over a
-    maneuver that hardly moves V is the same error) and lies within
+    maneuver that hardly moves V is the same error, or :data:`AIRSPEED_ERROR_FLOOR_FPS`) and lies within
     :data:`term_rules.IMITATION_Z` standard errors of the kinematics' bias estimate (the two
     estimates' colored standard errors taken together, as independent), and the term fitted
     beside the signature falls below the entry t (:data:`candidates.T_IN`), it is withheld.
@@ -94,7 +102,7 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
         # the signature is what correcting the channels by a bias changes, so a recorded bias b
         # puts −b times it into the mismatch: the bias the fit says is minus its coefficient
         u, t_term = -float(alone[0]), float(both[0] / se_both[0]) if se_both[0] > 0 else 0.0
-        plausible = abs(u) <= PLAUSIBLE["scale"]["V"] * V0
+        plausible = abs(u) <= max(PLAUSIBLE["scale"]["V"] * V0, AIRSPEED_ERROR_FLOOR_FPS)
         spread = float(np.hypot(se, se_alone[0]))
         allowed = np.isfinite(spread) and abs(u - v) <= IMITATION_Z * spread
         c.details["beside_the_airspeed"] = {"bias_fps": u, "std_error": float(se_alone[0]), "t": t_term}
