@@ -53,11 +53,7 @@ NUISANCE_BIASES = ("alpha", "beta", "p", "q", "r", "ax", "ay", "az")
 MAX_SCALE_BIAS_CORRELATION = 0.99
 # A scale factor or time skew needs the channel to move: its own optimal smoothing must vary
 # by this many times the channel's noise level, or the column is mostly (coloured) noise and
-# the estimate an errors-in-variables artefact (a_x in a short maneuver: 0.7 times). A time
-# skew needs it to move this many times the smallest bias worth naming too (PRACTICAL): on a
-# noise-free record a channel the maneuver hardly moves stands far above its noise, and a
-# probe's F-4N (650 ft/s, pitch sweep) had an r skew of −27 ms named (t −6.1) beside its right
-# stabilator delay, r moving only by the airframe's faint coupling (probe seed 4016).
+# the estimate an errors-in-variables artefact (a_x in a short maneuver: 0.7 times).
 MIN_EXCITATION = 3.0
 UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s", "phi": "rad",
          "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
@@ -292,9 +288,6 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
                 if columns.pop(f"{kind}_{c}", None) is not None:
                     dropped[f"{kind}_{c}"] = (f"{c} hardly moves ({moves / max(p.noise_std[c], 1e-300):.1f} times its "
                                               f"noise level): a {kind} cannot be told from noise")
-        elif moves < MIN_EXCITATION * PRACTICAL["bias"].get(c, 0.0) and columns.pop(f"skew_{c}", None) is not None:
-            dropped[f"skew_{c}"] = (f"{c} hardly moves ({moves:.3g} {UNITS[c]}, under {MIN_EXCITATION:g} times the "
-                                    f"smallest {c} bias worth naming): a skew of it would be no practical error")
     for c in SCALE_CHANNELS:
         s, b = columns.get(f"scale_{c}"), columns.get(f"bias_{c}")
         if s is not None and b is not None and np.ptp(s) > 0 and np.ptp(b) > 0:
