@@ -1197,6 +1197,17 @@ def test_a_slow_aircraft_s_airspeed_error_of_a_tenth_is_not_read_as_its_rate_der
     assert "an airspeed error of" in term["reason"], term["reason"]
 
 
+def test_no_skew_of_a_rate_the_maneuver_did_not_drive(tmp_path):
+    """The probe's seed 4016 (tests/probe/gen.py): a noise-free F-4N (20,300 ft / 650 ft/s,
+    stabilator sweep at 50 Hz) with a 71 ms stabilator delay. The delay was named right and beside
+    it an r skew of −27 ms (t −6.1), r moving only by the airframe's faint coupling: far above its
+    noise (none), far under the smallest r bias worth naming. A skew of a state the maneuver did
+    not drive now needs it to move three times that bias (kinematics.MIN_EXCITATION, PRACTICAL)."""
+    truth, result = _diagnosed_probe(4016, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "F4N" and truth["parameter"] == "tau_de" and truth["noise_factor"] == 0.0
+    _named_alone(result, truth, rel=0.05)
+
+
 def test_a_delay_on_a_surface_whose_samples_are_noisy_is_scanned(tmp_path):
     """The probe's seed 3637 (tests/probe/gen.py): an F-16 (27,400 ft / 716 ft/s, three-axis
     sweeps at 40 Hz, noise twice flight test's) with a 96 ms stabilator delay. Its 1° sweep stands

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.signal import detrend
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
-from harness.diagnosis.prepare import Prepared, clean_channels, interior_slice
+from harness.diagnosis.prepare import DRIVEN_BY, Prepared, clean_channels, interior_slice
 from models.constants import G0_FPS2 as G0
 from models.hidden import vane_shift
 
@@ -53,7 +53,13 @@ NUISANCE_BIASES = ("alpha", "beta", "p", "q", "r", "ax", "ay", "az")
 MAX_SCALE_BIAS_CORRELATION = 0.99
 # A scale factor or time skew needs the channel to move: its own optimal smoothing must vary
 # by this many times the channel's noise level, or the column is mostly (coloured) noise and
-# the estimate an errors-in-variables artefact (a_x in a short maneuver: 0.7 times).
+# the estimate an errors-in-variables artefact (a_x in a short maneuver: 0.7 times). A state
+# the maneuver did not drive (prepare.DRIVEN_BY: r on a pitch maneuver) needs it to move this
+# many times the smallest bias worth naming too (PRACTICAL) before its skew is a candidate: on
+# a noise-free record such a state stands far above its noise, and a probe's F-4N (650 ft/s,
+# pitch sweep) had an r skew of −27 ms named (t −6.1) beside its right stabilator delay, r
+# moving only by the airframe's faint coupling (probe seed 4016). A driven state is exempt: a
+# light aircraft's α moves a degree or two and its vane's lag is still read right.
 MIN_EXCITATION = 3.0
 UNITS = {"alpha": "rad", "beta": "rad", "V": "ft/s", "p": "rad/s", "q": "rad/s", "r": "rad/s", "phi": "rad",
          "theta": "rad", "ax": "g", "ay": "g", "az": "g"}
@@ -288,6 +294,11 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
                 if columns.pop(f"{kind}_{c}", None) is not None:
                     dropped[f"{kind}_{c}"] = (f"{c} hardly moves ({moves / max(p.noise_std[c], 1e-300):.1f} times its "
                                               f"noise level): a {kind} cannot be told from noise")
+        elif (c in DRIVEN_BY and c not in p.driven and moves < MIN_EXCITATION * PRACTICAL["bias"][c]
+              and columns.pop(f"skew_{c}", None) is not None):
+            dropped[f"skew_{c}"] = (f"{c} hardly moves and the maneuver did not drive it ({moves:.3g} {UNITS[c]}, under "
+                                    f"{MIN_EXCITATION:g} times the smallest {c} bias worth naming): a skew of it would "
+                                    "be no practical error")
     for c in SCALE_CHANNELS:
         s, b = columns.get(f"scale_{c}"), columns.get(f"bias_{c}")
         if s is not None and b is not None and np.ptp(s) > 0 and np.ptp(b) > 0:
