@@ -1208,6 +1208,20 @@ def test_no_skew_of_a_rate_the_maneuver_did_not_drive(tmp_path):
     _named_alone(result, truth, rel=0.05)
 
 
+def test_no_gyro_scale_where_an_untestable_vane_scale_explains_the_same(tmp_path):
+    """The probe's seed 4046 (tests/probe/gen.py): a c172r (4,100 ft / 178 ft/s, pitch 2-1-1 at
+    50 Hz, flight-test noise, no trim in the metadata) whose α vane reads 5.9 % low. α moves
+    2.2 times its vane's noise, so an α scale is no candidate; a q-gyro scale of +4.6 % was named
+    instead (kinematic t 4.4, C_m agreeing). Beside the α scale it falls to t 0.1: nothing is
+    named, and the α scale is reported as not checked."""
+    truth, result = _diagnosed_probe(4046, tmp_path, calibrate=False)
+    assert truth["parameter"] == "scale_alpha" and "no_trim" in truth["conventions"]
+    assert _found(result) == []
+    scale_q = next(c for c in result["candidates"] if c["parameter"] == "scale_q")
+    assert "cannot tell it from scale_alpha" in scale_q["reason"], scale_q["reason"]
+    assert any("scale_alpha" in n["parameters"] for n in result["not_checked"])
+
+
 def test_a_delay_on_a_surface_whose_samples_are_noisy_is_scanned(tmp_path):
     """The probe's seed 3637 (tests/probe/gen.py): an F-16 (27,400 ft / 716 ft/s, three-axis
     sweeps at 40 Hz, noise twice flight test's) with a 96 ms stabilator delay. Its 1° sweep stands

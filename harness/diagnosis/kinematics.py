@@ -252,6 +252,7 @@ class KinematicResult:
     residual_rms: dict[str, float]   # per equation, before (weighted units removed)
     start: np.ndarray                # stacked weighted residual before corrections
     columns: dict | None = None      # every offered parameter's stacked weighted column (forced too)
+    untestable: dict | None = None   # the columns of scales and skews left out because their channel hardly moves
 
 
 T_IN = 6.0
@@ -286,12 +287,13 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
         minus = kinematic_residuals(sp.correct(at, p, -sp.step), p)
         # E(0) ≈ −J θ: regress E(0) on −J
         columns[name] = np.concatenate([-(plus[e][inner] - minus[e][inner]) / (2 * sp.step) * weights[e] for e in eqs])
-    dropped = {}
+    dropped, untestable = {}, {}
     for c in set(SCALE_CHANNELS) | set(SKEW_CHANNELS):
         moves = float(np.std(clean[c][inner])) if c in clean else 0.0
         if c in p.noise_std and moves < MIN_EXCITATION * p.noise_std[c]:
             for kind in ("scale", "skew"):
-                if columns.pop(f"{kind}_{c}", None) is not None:
+                if (column := columns.pop(f"{kind}_{c}", None)) is not None:
+                    untestable[f"{kind}_{c}"] = column
                     dropped[f"{kind}_{c}"] = (f"{c} hardly moves ({moves / max(p.noise_std[c], 1e-300):.1f} times its "
                                               f"noise level): a {kind} cannot be told from noise")
         elif (c in DRIVEN_BY and c not in p.driven and moves < MIN_EXCITATION * PRACTICAL["bias"][c]
@@ -316,7 +318,7 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
     return KinematicResult(selection=sel, parameters=params, forced=tuple(forced), dropped=dropped,
                            equations=eqs, weights=weights,
                            residual_rms={e: float(np.sqrt(np.mean(e0[e][inner] ** 2))) for e in eqs}, start=stack,
-                           columns=offered)
+                           columns=offered, untestable=untestable)
 
 
 # The largest error an instrument of each kind plausibly has (a vane 5 deg off, a gyro 5 deg/s,

@@ -15,7 +15,7 @@ from harness.diagnosis.exact_skew import scale_beside_exact_skew
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
-                                            kinematic_t_beside, unit_members,
+                                            kinematic_t_beside, unit_members, untestable_rival,
                                             kinematics_refute, sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
 from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel, term_change
@@ -271,6 +271,9 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
             continue
         verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN,
                                           tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
+        if verdict.named and (rival := untestable_rival(kin, name)) is not None:
+            _withhold_beside_untestable(sensor, kin, verdict, t, *rival)
+            continue
         if _name_if_corroborated(sensor, kin, p, verdict, t):
             named.append(sensor)
     withhold_corroborated_rivals(named, kin)
@@ -278,6 +281,23 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
         for c in cands:
             if sensor.selected and c.details.get("sensor_rival") == sensor.parameter:
                 c.reason += f"; explained by the {sensor.parameter} named"
+
+
+def _withhold_beside_untestable(sensor: Candidate, kin: KinematicResult, verdict, t_kin: float, rival: str,
+                                t_beside: float) -> None:
+    """Leave ``sensor`` unnamed, corroborated or not: the kinematics that suspected it (at
+    ``t_kin``, under their entry t) cannot tell it from ``rival``, an error the maneuver cannot
+    test (its channel hardly moves, :attr:`KinematicResult.untestable`), beside which it falls
+    to ``t_beside``. Nor can the coefficient mismatch: a scaled α and a scaled q both follow
+    the short period's C_m. A probe's c172r (178 ft/s, pitch 2-1-1, α moving 2.2 times its
+    vane's noise) with its α vane reading 5.9 % low had a q-gyro scale of +4.6 % named
+    (kinematic t 4.4, C_m agreeing); beside the α scale it stands at t 0.1."""
+    sensor.details["corroboration"] = verdict.as_dict()
+    sensor.details["untestable_rival"] = {"parameter": rival, "t_beside": t_beside}
+    channel = kin.parameters[rival].channel
+    sensor.reason = (f"not named: the coefficient mismatch corroborates it, but the kinematics (t = {t_kin:.1f}) "
+                     f"cannot tell it from {rival}, which this maneuver cannot test ({channel} hardly moves): "
+                     f"beside it this falls to t = {t_beside:.1f}")
 
 
 def withhold_scale_left_by_a_linearised_skew(cands: list[Candidate], kin: KinematicResult, recorded: Prepared) -> None:

@@ -412,6 +412,32 @@ def kinematic_t_beside(kin: KinematicResult, added: str | tuple[str, ...],
     return {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
 
 
+def untestable_rival(kin: KinematicResult, name: str, t_min: float = cand.AMBIGUOUS_T) -> tuple[str, float] | None:
+    """The scale or skew left out of the kinematic check because its channel hardly moves
+    (:attr:`KinematicResult.untestable`) beside which sensor parameter ``name`` falls under
+    ``t_min``, with ``name``'s |t| there (the rival taking most from it); None when there is none.
+    The kinematic fit is that of the forced and selected terms with ``name`` and the rival added
+    (colored-residual standard errors, no constant)."""
+    cols = kin.columns or {}
+    if name not in cols:
+        return None
+    base = [n for n in kin.forced + kin.selection.names if n in cols and n != name]
+    worst = None
+    for rival, column in (kin.untestable or {}).items():
+        if kin.parameters[rival].channel == kin.parameters[name].channel:
+            continue
+        names = base + [name, rival]
+        try:
+            theta, se, _ = colored_fit(kin.start, [cols[n] for n in base + [name]] + [column], names,
+                                       constant=False)
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            continue
+        t = abs(theta[-2] / se[-2]) if se[-2] > 0 else 0.0
+        if t < t_min and (worst is None or t < worst[1]):
+            worst = (rival, float(t))
+    return worst
+
+
 # The |t| a kinematic estimate needs before it corrects the channels the model is evaluated on.
 APPLY_T = 3.0
 
