@@ -1208,6 +1208,18 @@ def test_no_skew_of_a_rate_the_maneuver_did_not_drive(tmp_path):
     _named_alone(result, truth, rel=0.05)
 
 
+def test_no_skew_of_a_rate_a_noise_free_pitch_maneuver_did_not_drive(tmp_path):
+    """The probe's seed 4035: a noise-free 737 (24,800 ft / 483 ft/s, stabilator sweep) with its
+    moment reference 0.46 ft forward had an r skew of −96 ms named (t −6.6), r moving by the
+    airframe's coupling alone; it is no candidate now (kinematics.MIN_EXCITATION, PRACTICAL),
+    and nothing else is named."""
+    truth, result = _diagnosed_probe(4035, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "737" and truth["kind"] == "pitch" and truth["noise_factor"] == 0.0
+    assert [p for p, _ in _found(result)] in ([], [truth["parameter"]])
+    skew_r = next((c for c in result["candidates"] if c["parameter"] == "skew_r"), None)
+    assert skew_r is None or not skew_r["selected"]
+
+
 def test_no_gyro_scale_where_an_untestable_vane_scale_explains_the_same(tmp_path):
     """The probe's seed 4046 (tests/probe/gen.py): a c172r (4,100 ft / 178 ft/s, pitch 2-1-1 at
     50 Hz, flight-test noise, no trim in the metadata) whose α vane reads 5.9 % low. α moves
