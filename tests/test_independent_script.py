@@ -1187,7 +1187,7 @@ def test_a_slow_aircraft_s_airspeed_error_of_a_tenth_is_not_read_as_its_rate_der
     normalised by the biased V put −10 % of each rate term into the mismatch, and C_l,p̂ −0.054
     (t −45), C_n,p̂ and C_l,r̂ were named: the airspeed error that fits in their place was over
     the 10 % of V allowed an instrument. At least 10 kt is allowed now
-    (airspeed_rules.AIRSPEED_ERROR_FLOOR_FPS): none is named (the bias itself, t 3 in the
+    (kinematics.AIRSPEED_ERROR_FLOOR_FPS): none is named (the bias itself, t 3 in the
     kinematics, is missed)."""
     # calibrated, as the command line does: a C_Y,p̂ change of +0.029 also enters, which the loop withdraws
     truth, result = _diagnosed_probe(3859, tmp_path, calibrate_workers=1)
@@ -1195,6 +1195,18 @@ def test_a_slow_aircraft_s_airspeed_error_of_a_tenth_is_not_read_as_its_rate_der
     assert _found(result) == []
     term = next(c for c in result["candidates"] if c["parameter"] == "Cl_phat")
     assert "an airspeed error of" in term["reason"], term["reason"]
+
+
+def test_a_slow_aircraft_s_airspeed_bias_is_named_and_the_model_trimmed_where_it_flew(tmp_path):
+    """The probe's seed 3998: a noise-free J-3 Cub (2,900 ft / 103 ft/s, stabilator doublet) with
+    V 8.8 ft/s high, 8.6 % of V. The bias was left out of the kinematic fit as implausible (over
+    5 % of V; at least 10 kt is allowed now, kinematics.AIRSPEED_ERROR_FLOOR_FPS) and an α scale
+    of −0.041, then a C_m,δe 2.3 % weaker than the model, were named: the model had been trimmed
+    at the recorded airspeed, its propeller's thrust and slipstream those of a faster flight.
+    Trimmed at the corrected airspeed (analysis.corrected_start) the bias alone is named."""
+    truth, result = _diagnosed_probe(3998, tmp_path, calibrate_workers=1)
+    assert truth["aircraft"] == "J3Cub" and truth["parameter"] == "bias_V" and truth["noise_factor"] == 0.0
+    _named_alone(result, truth, rel=0.25)
 
 
 def test_no_skew_of_a_rate_the_maneuver_did_not_drive(tmp_path):

@@ -9,7 +9,7 @@ from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, interior, model_along
 from harness.diagnosis.evidence import Candidate
-from harness.diagnosis.kinematics import PLAUSIBLE, KinematicResult
+from harness.diagnosis.kinematics import AIRSPEED_ERROR_FLOOR_FPS, PLAUSIBLE, KinematicResult
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import kinematic_estimate, kinematic_std_error
 from harness.diagnosis.stepwise_axes import StepwiseFits
@@ -29,14 +29,6 @@ NORMALISED = ("phat", "qhat", "rhat")
 
 # The airspeed error probed for the signature, as a share of the airspeed (it is linear there).
 SIGNATURE_SHARE = 0.01
-
-# An airspeed error an instrument could make is within 10 % of V (kinematics.PLAUSIBLE's
-# airspeed scale) or within this, whichever is larger (ft/s, 10 kt): a light aircraft's
-# pitot-static position error at low speed alone reaches several knots (the Cessna 172S
-# Pilot's Operating Handbook's airspeed calibration, Section 5: 50 KIAS is 56 KCAS, flaps up).
-# A probe's J-3 Cub at 103 ft/s with V 11.9 ft/s high (11.5 %) had C_l,p̂ named −0.054
-# (t −45) in the error's place (probe seed 3859).
-AIRSPEED_ERROR_FLOOR_FPS = 16.9
 
 
 def normalised_by_airspeed(c: Candidate) -> bool:
@@ -67,7 +59,7 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
     (:func:`airspeed_signature`) in the term's place (with the axis's other selected terms and
     its nuisance columns); when the airspeed error so sized is one an instrument could make
     (within :data:`kinematics.PLAUSIBLE`'s 10 % of V for an airspeed scale, which over a
-    maneuver that hardly moves V is the same error, or :data:`AIRSPEED_ERROR_FLOOR_FPS`) and lies within
+    maneuver that hardly moves V is the same error, or :data:`kinematics.AIRSPEED_ERROR_FLOOR_FPS`) and lies within
     :data:`term_rules.IMITATION_Z` standard errors of the kinematics' bias estimate (the two
     estimates' colored standard errors taken together, as independent), and the term fitted
     beside the signature falls below the entry t (:data:`candidates.T_IN`), it is withheld.

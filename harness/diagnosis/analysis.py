@@ -49,7 +49,7 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_the_shift_remainder)
 from harness.diagnosis.wander_rules import withhold_within_the_unseen_wander
 from models.aircraft import Aircraft, has_propeller
-from models.replay import InitialCondition
+from models.replay import InitialCondition, initial_condition
 
 
 def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
@@ -65,22 +65,39 @@ def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str,
 
 
 def _along_corrected(recorded: Prepared, kin: KinematicResult, values: dict[str, float], aircraft: Aircraft,
-                     ic: InitialCondition) -> tuple[Prepared, ModelAlong, dict[str, np.ndarray], dict[str, dict]]:
+                     ic: InitialCondition) -> tuple[Prepared, ModelAlong, dict[str, np.ndarray], dict[str, dict],
+                                                    InitialCondition]:
     """The recording corrected for the sensor ``values``, the model along it, its mismatch,
-    and the accelerometer position components the force mismatch there refutes
-    (:func:`accelerometer_rules.refuted_positions`): those are taken out of ``values`` (in
-    place) and the correction and the model made again without them."""
+    the accelerometer position components the force mismatch there refutes
+    (:func:`accelerometer_rules.refuted_positions`: those are taken out of ``values`` in
+    place and the correction and the model made again without them), and the initial
+    condition (:func:`corrected_start`)."""
     p = corrected_recording(recorded, kin, values)
-    along = model_along(p, aircraft, ic)
+    start = corrected_start(p, values, ic)
+    along = model_along(p, aircraft, start)
     mismatch = along.mismatch()
     refuted = refuted_positions(p, mismatch, coefficient_noise(p, mismatch), values)
     if refuted:
         for name in refuted:
             values.pop(name)
         p = corrected_recording(recorded, kin, values)
-        along = model_along(p, aircraft, ic)
+        start = corrected_start(p, values, ic)
+        along = model_along(p, aircraft, start)
         mismatch = along.mismatch()
-    return p, along, mismatch, refuted
+    return p, along, mismatch, refuted, start
+
+
+def corrected_start(p: Prepared, values: dict[str, float], ic: InitialCondition) -> InitialCondition:
+    """The initial condition of the corrected recording ``p`` when a correction in ``values``
+    changed its airspeed or angle of attack, else ``ic``. The model is trimmed there (its
+    thrust, and with it a propeller's slipstream over the tail), so it must start where the
+    aircraft was, not where its instruments said it was: a probe's J-3 Cub (103 ft/s, pitch
+    doublet, noise-free) with V 8.8 ft/s high, trimmed at the recorded airspeed with the bias
+    named and taken out of the channels, had C_m,δe named 2.3 % weaker than the model (t 23),
+    the slipstream of the faster trim's thrust (probe seed 3998)."""
+    if not any(n.split("_", 1)[-1] in ("V", "alpha") for n in values):
+        return ic
+    return initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude, phi=p.smooth.get("phi"))
 
 
 def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
@@ -103,7 +120,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     sensor_values = {n: v for n, v in applied_sensor_values(kin, turbulent or bool(gusty), plausible, V0).items()
                      if n not in unapplied and steady_vane(n, p) is None}
     # 2. the model along the measured states
-    recorded, (p, along, mismatch, refuted) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
+    recorded, (p, along, mismatch, refuted, ic) = p, _along_corrected(p, kin, sensor_values, aircraft, ic)
     states, surfaces, alphadot, aero, measured = along[:5]
     slope_of = slope_function(aircraft, ic, states, surfaces, alphadot, aero, along.weights)
     # 0'. gusts or vane error: the aerodynamics say which (no sensor value is applied in either)

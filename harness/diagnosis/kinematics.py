@@ -332,6 +332,14 @@ PLAUSIBLE = {"bias": {"alpha": 5.0 * DEG, "beta": 5.0 * DEG, "V": 0.05, "p": 5.0
 # (vanes: upwash scale errors of tens of percent are real; a pitot-static airspeed 10 %;
 # rates and accelerations: the default below)
 PLAUSIBLE_SCALE_DEFAULT = 0.1
+# An airspeed error an instrument could make is within PLAUSIBLE's share of V or within this,
+# whichever is larger (ft/s, 10 kt): a light aircraft's pitot-static position error at low
+# speed alone reaches several knots (the Cessna 172S Pilot's Operating Handbook's airspeed
+# calibration, Section 5: 50 KIAS is 56 KCAS, flaps up). A probe's J-3 Cub at 103 ft/s with V
+# 11.9 ft/s high (11.5 %) had C_l,p̂ named −0.054 (t −45) in the error's place (probe seed
+# 3859); another at 103 ft/s with V 8.8 ft/s high (8.6 %, over 5 % of V) had the bias left out
+# of the kinematic fit as implausible and C_m,δe named in its place (probe seed 3998).
+AIRSPEED_ERROR_FLOOR_FPS = 16.9
 
 
 def is_plausible(name: str, value: float, V_fps: float) -> bool:
@@ -340,7 +348,7 @@ def is_plausible(name: str, value: float, V_fps: float) -> bool:
     kind, _, channel = name.partition("_")
     if kind == "bias":
         limit = PLAUSIBLE["bias"].get(channel, np.inf)
-        return abs(value) <= (limit * V_fps if channel == "V" else limit)
+        return abs(value) <= (max(limit * V_fps, AIRSPEED_ERROR_FLOOR_FPS) if channel == "V" else limit)
     if kind == "scale":
         return abs(value) <= PLAUSIBLE["scale"].get(channel, PLAUSIBLE_SCALE_DEFAULT)
     if kind == "skew":

@@ -271,7 +271,7 @@ def name_corroborated(cands: list[Candidate], kin: KinematicResult, p: Prepared,
             continue
         verdict = corroborate.corroborate(name, v, abs(v) / t, signature(name, v), t_aero=cand.T_IN,
                                           tolerance=corroborate.gyro_skew_tolerance(name, p.dt))
-        if verdict.named and (rival := untestable_rival(kin, name)) is not None:
+        if verdict.named and (rival := untestable_rival(kin, name, V0)) is not None:
             _withhold_beside_untestable(sensor, kin, verdict, t, *rival)
             continue
         if _name_if_corroborated(sensor, kin, p, verdict, t):

@@ -412,12 +412,17 @@ def kinematic_t_beside(kin: KinematicResult, added: str | tuple[str, ...],
     return {n: abs(theta[i] / se[i]) if se[i] > 0 else 0.0 for i, n in enumerate(names)}
 
 
-def untestable_rival(kin: KinematicResult, name: str, t_min: float = cand.AMBIGUOUS_T) -> tuple[str, float] | None:
+def untestable_rival(kin: KinematicResult, name: str, V_fps: float,
+                     t_min: float = cand.AMBIGUOUS_T) -> tuple[str, float] | None:
     """The scale or skew left out of the kinematic check because its channel hardly moves
-    (:attr:`KinematicResult.untestable`) beside which sensor parameter ``name`` falls under
-    ``t_min``, with ``name``'s |t| there (the rival taking most from it); None when there is none.
-    The kinematic fit is that of the forced and selected terms with ``name`` and the rival added
-    (colored-residual standard errors, no constant)."""
+    (:attr:`KinematicResult.untestable`) that takes sensor parameter ``name``'s place: beside
+    it ``name`` falls under ``t_min`` and the rival stands at ``t_min`` or more, at a size an
+    instrument could have (:func:`is_plausible`, at airspeed ``V_fps``). Returns the rival and
+    ``name``'s |t| beside it (the rival taking most from it); None when there is none. The
+    kinematic fit is that of the forced and selected terms with ``name`` and the rival added
+    (colored-residual standard errors, no constant). A rival that only shares the column (an
+    a_y skew beside a β scale on a lateral maneuver, a_y following β: −0.26 ± 0.40 s) is no
+    explanation."""
     cols = kin.columns or {}
     if name not in cols:
         return None
@@ -426,14 +431,14 @@ def untestable_rival(kin: KinematicResult, name: str, t_min: float = cand.AMBIGU
     for rival, column in (kin.untestable or {}).items():
         if kin.parameters[rival].channel == kin.parameters[name].channel:
             continue
-        names = base + [name, rival]
         try:
-            theta, se, _ = colored_fit(kin.start, [cols[n] for n in base + [name]] + [column], names,
-                                       constant=False)
+            theta, se, _ = colored_fit(kin.start, [cols[n] for n in base + [name]] + [column],
+                                       base + [name, rival], constant=False)
         except (SingularRegressorsError, np.linalg.LinAlgError):
             continue
-        t = abs(theta[-2] / se[-2]) if se[-2] > 0 else 0.0
-        if t < t_min and (worst is None or t < worst[1]):
+        t, t_rival = (abs(theta[k] / se[k]) if se[k] > 0 else 0.0 for k in (-2, -1))
+        if (t < t_min <= t_rival and is_plausible(rival, float(theta[-1]), V_fps)
+                and (worst is None or t < worst[1])):
             worst = (rival, float(t))
     return worst
 
