@@ -81,16 +81,17 @@ def test_peak_at_a_given_frequency():
     assert spectra.peak_at(rec, "q", 13.0) > spectra.MODE_CONFIRM_P
     assert np.isnan(spectra.peak_at(rec, "az", 8.0)) and np.isnan(spectra.peak_at(rec, "q", 30.0))
     assert "does not record az" in spectra.untestable_at(rec, "az", 8.0)
-    assert "band is 2.1-22.5 Hz" in spectra.untestable_at(rec, "q", 1.5)
+    assert "band is 2.0-22.5 Hz" in spectra.untestable_at(rec, "q", 1.5)
     slow = _record(q=rec.raw["q"])
-    slow.common_cutoff_hz = 2.9  # its smoothing keeps 8 Hz as motion
-    assert np.isnan(spectra.peak_at(slow, "q", 8.0)) and "cut-off of 2.9 Hz" in spectra.untestable_at(slow, "q", 8.0)
+    slow.common_cutoff_hz = 2.9  # the search starts at 1.5 times it: 4 Hz is kept as motion
+    assert np.isnan(spectra.peak_at(slow, "q", 4.0)) and "cut-off of 2.9 Hz" in spectra.untestable_at(slow, "q", 4.0)
+    assert spectra.peak_at(slow, "q", 8.0) < spectra.MODE_CONFIRM_P
 
 
 def test_a_mode_inside_a_quiet_records_filter_band_is_still_searched():
     """A quiet record's common filter keeps everything to 20 Hz, a 9.4 Hz mode with it: the
-    mode search takes the motion to end at RIGID_BODY_CUTOFF_HZ (3 Hz), searches from three
-    times that and finds the mode; what the common filter itself leaves holds nothing."""
+    mode search takes the motion to end at RIGID_BODY_CUTOFF_HZ (3 Hz), searches from
+    MOTION_POWER_FACTOR times that and finds the mode; what the common filter itself leaves holds nothing."""
     rng = np.random.default_rng(5)
     t = np.arange(N) / FS
     q = 0.05 * np.sin(2 * np.pi * 0.4 * t) + 0.002 * np.sin(2 * np.pi * 9.4 * t) + 1e-5 * rng.normal(size=N)
@@ -99,7 +100,7 @@ def test_a_mode_inside_a_quiet_records_filter_band_is_still_searched():
     rec = SimpleNamespace(dt=1.0 / FS, n=N, t=t, raw={"q": q}, smooth={"q": sine_series_filter(q, w)}, weights=w,
                           common_cutoff_hz=20.0)
     assert spectra.motion_cutoff_hz(rec) == spectra.RIGID_BODY_CUTOFF_HZ
-    assert spectra.search_floor_hz(rec) == 3.0 * spectra.RIGID_BODY_CUTOFF_HZ
+    assert spectra.search_floor_hz(rec) == spectra.MOTION_POWER_FACTOR * spectra.RIGID_BODY_CUTOFF_HZ
     assert np.std(rec.raw["q"] - rec.smooth["q"]) < 1e-4 < 1e-3 < np.std(spectra.mode_residual(rec, "q"))
     peak = spectra.structural_peak(rec)
     assert peak.p_value < spectra.FISHER_P and abs(peak.frequency_hz - 9.4) < 0.1

@@ -35,8 +35,14 @@ GUST_HIGHPASS_HZ = 0.05  # the gust estimate drops what sensor-bias drift puts b
 # aircraft lie below about 1.2 Hz, and the best smoothing cut-off lies about 0.5 Hz above a
 # signal's band (Morelli, Practical Aspects of the Equation-Error Method, Eq. 18 and the
 # smoothing section); 3 Hz leaves room for a light aircraft's roll mode and an actuator's
-# roll-off, and puts the search from 9 Hz (three times it) at the latest.
+# roll-off.
 RIGID_BODY_CUTOFF_HZ = 3.0
+# The mode search starts this many times above the motion's cut-off (:func:`search_floor_hz`),
+# where the maneuver itself has little power left: from 4.5 Hz at the latest. At three times
+# (9 Hz) a probe's J-3 Cub (111 ft/s, pitch 3-2-1-1, noise half flight test's) rang a 6.5 Hz
+# wing mode at 0.8 deg/s in q unseen (probe seed 4078). A peak must still beat its running
+# median and be no echo of an input's line (:func:`structural_peak`).
+MOTION_POWER_FACTOR = 1.5
 
 
 @dataclass(frozen=True)
@@ -69,8 +75,8 @@ def welch_dof(n: int, nperseg: int) -> float:
 def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
                     half_width_hz: float = 2.5) -> PeakTest | None:
     """The most significant peak in what the motion leaves of each rate and acceleration
-    channel (:func:`mode_residual`), above :func:`search_floor_hz` (``f_min_hz`` or three
-    times the motion's cut-off, where the maneuver itself has little power).
+    channel (:func:`mode_residual`), above :func:`search_floor_hz` (where the maneuver itself
+    has little power).
 
     The spectrum is Welch's (Hann, ``segment_s`` segments, 50 % overlap): averaging makes a
     lightly damped mode, rung by each input and decaying within a second or two, a peak a
@@ -179,9 +185,8 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
                   f_min_hz: float = 2.0) -> str:
     """Why record ``p`` cannot show a mode of ``channel`` at ``frequency_hz`` ('' when it can):
     the channel is not recorded, the record is shorter than four Welch segments, or the
-    frequency lies outside the band :func:`structural_peak` searches (below ``f_min_hz`` or
-    three times the record's common-filter cut-off, whose smoothing keeps it as motion; above
-    0.9 times Nyquist)."""
+    frequency lies outside the band :func:`structural_peak` searches (below
+    :func:`search_floor_hz`; above 0.9 times Nyquist)."""
     fs = 1.0 / p.dt
     if channel not in p.raw:
         return f"it does not record {channel}"
@@ -190,11 +195,11 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
     low = search_floor_hz(p, f_min_hz)
     cut = motion_cutoff_hz(p)
     if low >= 0.45 * fs:
-        return (f"it has no spectral band to search: three times its motion's cut-off of {cut:.1f} Hz lies above 0.9 "
-                f"of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping everything below as motion")
+        return (f"it has no spectral band to search: {MOTION_POWER_FACTOR:g} times its motion's cut-off of {cut:.1f} Hz "
+                f"lies above 0.9 of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping everything below as motion")
     if not low <= frequency_hz <= 0.9 * 0.5 * fs:
-        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or three times its motion's "
-                f"cut-off of {cut:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
+        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or {MOTION_POWER_FACTOR:g} times "
+                f"its motion's cut-off of {cut:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
     return ""
 
 
@@ -205,10 +210,10 @@ def motion_cutoff_hz(p: Prepared) -> float:
 
 
 def search_floor_hz(p: Prepared, f_min_hz: float = 2.0) -> float:
-    """The lowest frequency the mode search looks at: ``f_min_hz`` or three times
-    :func:`motion_cutoff_hz`, whichever is higher (the maneuver itself has little power
-    there)."""
-    return max(f_min_hz, 3.0 * motion_cutoff_hz(p))
+    """The lowest frequency the mode search looks at: ``f_min_hz`` or
+    :data:`MOTION_POWER_FACTOR` times :func:`motion_cutoff_hz`, whichever is higher (the
+    maneuver itself has little power there)."""
+    return max(f_min_hz, MOTION_POWER_FACTOR * motion_cutoff_hz(p))
 
 
 def mode_residual(p: Prepared, channel: str) -> np.ndarray:
