@@ -1212,7 +1212,7 @@ def test_a_slow_aircraft_s_airspeed_bias_is_named_and_the_model_trimmed_where_it
 def test_a_wing_mode_between_the_motion_and_three_times_its_cut_off_is_found(tmp_path):
     """The probe's seed 4078: a J-3 Cub (3,500 ft / 111 ft/s, pitch 3-2-1-1 at 50 Hz, noise half
     flight test's) whose q rings a 6.5 Hz mode at 0.8 deg/s. The motion ends at 3 Hz; searched
-    from three times that the mode went unseen and nothing was found. From 1.5 times
+    from three times that the mode went unseen and nothing was found. From twice it
     (spectra.MOTION_POWER_FACTOR) it is named at its frequency."""
     truth, result = _diagnosed_probe(4078, tmp_path, calibrate=False)
     assert truth["aircraft"] == "J3Cub" and truth["parameter"] == "mode_frequency_hz"

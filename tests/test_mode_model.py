@@ -190,15 +190,15 @@ def test_the_mode_band_is_put_back_only_where_the_mode_rings(driven):
 
 def test_a_record_whose_smoothing_keeps_the_whole_band_has_none_to_search(driven):
     """spectra.untestable_at: a common-filter cut-off of 9 Hz is taken as the motion's 3 Hz
-    (spectra.RIGID_BODY_CUTOFF_HZ), so a 50 Hz record searches 4.5-22.5 Hz (1.5 times it,
-    spectra.MOTION_POWER_FACTOR); at 10 Hz that floor reaches 0.9 of Nyquist (4.5 Hz): no band,
-    said so (not an inverted band)."""
+    (spectra.RIGID_BODY_CUTOFF_HZ), so a 50 Hz record searches 6-22.5 Hz (twice it,
+    spectra.MOTION_POWER_FACTOR); at 10 Hz that floor lies above 0.9 of Nyquist (4.5 Hz): no
+    band, said so (not an inverted band)."""
     from dataclasses import replace
 
     from harness.diagnosis.spectra import untestable_at
     _, p = driven
     quiet = replace(p, common_cutoff_hz=9.0)
-    assert "band is 4.5-22.5 Hz" in untestable_at(quiet, "q", 4.0) and untestable_at(quiet, "q", 8.0) == ""
+    assert "band is 6.0-22.5 Hz" in untestable_at(quiet, "q", 4.0) and untestable_at(quiet, "q", 8.0) == ""
     why = untestable_at(replace(quiet, dt=0.1), "q", 4.0)
     assert why.startswith("it has no spectral band to search") and "(4.5 Hz)" in why
     assert untestable_at(p, "q", 8.0) == ""

@@ -83,7 +83,7 @@ def test_peak_at_a_given_frequency():
     assert "does not record az" in spectra.untestable_at(rec, "az", 8.0)
     assert "band is 2.0-22.5 Hz" in spectra.untestable_at(rec, "q", 1.5)
     slow = _record(q=rec.raw["q"])
-    slow.common_cutoff_hz = 2.9  # the search starts at 1.5 times it: 4 Hz is kept as motion
+    slow.common_cutoff_hz = 2.9  # the search starts at twice it: 4 Hz is kept as motion
     assert np.isnan(spectra.peak_at(slow, "q", 4.0)) and "cut-off of 2.9 Hz" in spectra.untestable_at(slow, "q", 4.0)
     assert spectra.peak_at(slow, "q", 8.0) < spectra.MODE_CONFIRM_P
 

@@ -38,11 +38,13 @@ GUST_HIGHPASS_HZ = 0.05  # the gust estimate drops what sensor-bias drift puts b
 # roll-off.
 RIGID_BODY_CUTOFF_HZ = 3.0
 # The mode search starts this many times above the motion's cut-off (:func:`search_floor_hz`),
-# where the maneuver itself has little power left: from 4.5 Hz at the latest. At three times
+# where the maneuver itself has little power left: from 6 Hz at the latest. At three times
 # (9 Hz) a probe's J-3 Cub (111 ft/s, pitch 3-2-1-1, noise half flight test's) rang a 6.5 Hz
-# wing mode at 0.8 deg/s in q unseen (probe seed 4078). A peak must still beat its running
-# median and be no echo of an input's line (:func:`structural_peak`).
-MOTION_POWER_FACTOR = 1.5
+# wing mode at 0.8 deg/s in q unseen (probe seed 4078). At 1.5 times the outside sweep's
+# c172x lateral maneuvers (cut-offs 1.5-1.9 Hz) gave "modes" at 1.9-2.4 Hz, the shoulder of
+# their own roll motion. A peak must still beat its running median and be no echo of an
+# input's line (:func:`structural_peak`).
+MOTION_POWER_FACTOR = 2.0
 
 
 @dataclass(frozen=True)
