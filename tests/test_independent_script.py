@@ -1219,6 +1219,30 @@ def test_a_wing_mode_between_the_motion_and_three_times_its_cut_off_is_found(tmp
     _named_alone(result, truth, rel=0.02)
 
 
+def test_an_offset_accelerometer_s_echo_of_a_lateral_input_is_no_mode(tmp_path):
+    """The probe's seed 4082: a J-3 Cub (3,800 ft / 100 ft/s, lateral doublets at 100 Hz) with its
+    accelerometer 5.3 ft left of the c.g. The position was named right and beside it a 4.95 Hz
+    "mode" in a_x (p 3e-8, the validation's too): the doublets' fifth harmonic read through ṙ·y,
+    a_x being asked only about the stabilator's lines. An accelerometer echoes every surface now
+    (spectra.ECHO_DRIVERS)."""
+    truth, result = _diagnosed_probe(4082, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "J3Cub" and truth["parameter"] == "offset_y"
+    _named_alone(result, truth, rel=0.25)
+
+
+def test_the_drag_a_named_lift_change_carries_is_no_second_finding(tmp_path):
+    """The probe's seed 4128: an F-4N (15,800 ft / 860 ft/s, pitch sweep at 100 Hz, noise 1.7
+    times flight test's) with a C_Z α² of −25 concealed as lift. It was named (−23 ± 4) and beside
+    it a C_X α² of −0.64 (t −7.9): the F-4N's induced drag, 0.14·C_L², follows the lift added.
+    Beside the drag-due-to-lift column (term_rules.induced_drag_column) the C_X term stands at
+    t 1.1, its factor k 0.16: the lift change is named alone."""
+    truth, result = _diagnosed_probe(4128, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "F4N" and truth["parameter"] == "CZ_alpha2"
+    _named_alone(result, truth, rel=0.25)
+    cx = next(c for c in result["candidates"] if c["parameter"] == "CX_alpha2")
+    assert "drag due to lift" in cx["reason"], cx["reason"]
+
+
 def test_no_skew_of_a_rate_the_maneuver_did_not_drive(tmp_path):
     """The probe's seed 4016 (tests/probe/gen.py): a noise-free F-4N (20,300 ft / 650 ft/s,
     stabilator sweep at 50 Hz) with a 71 ms stabilator delay. The delay was named right and beside

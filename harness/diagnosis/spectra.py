@@ -24,6 +24,11 @@ INPUT_LINE_P = 1e-3
 ECHO_P = 0.05
 # The surfaces that drive each channel a mode is sought in (an echo needs its input).
 MODE_DRIVERS = {"q": ("de",), "ax": ("de",), "az": ("de",), "p": ("da", "dr"), "r": ("da", "dr"), "ay": ("da", "dr")}
+# The surfaces whose lines each channel can echo (:func:`echoes`): an accelerometer off the c.g.
+# reads ω̇ × r, every surface's rate response, on every axis. A probe's J-3 Cub (100 ft/s,
+# lateral doublets, the accelerometer 5.3 ft left) had a 4.95 Hz "mode" named in a_x, the fifth
+# harmonic of its aileron doublet read through ṙ·y (probe seed 4082).
+ECHO_DRIVERS = MODE_DRIVERS | {c: ("de", "da", "dr") for c in ("ax", "ay", "az")}
 # The other maneuver's spectrum, at a mode frequency one record found (p < FISHER_P), shows
 # the mode too at this level (:func:`peak_at`: three ordinates at a frequency given in advance).
 MODE_CONFIRM_P = 0.01
@@ -266,8 +271,8 @@ def input_lines(p: Prepared, nper: int, dof: float, half_width_hz: float) -> dic
 def echoes(ratio: np.ndarray, idx: np.ndarray, channel: str, lines: dict[str, np.ndarray],
            dof: float) -> np.ndarray:
     """Which peaks (ordinates ``idx`` of ``channel``, standing ``ratio`` times above their
-    running median) are echoes of an input's line: a surface that drives the channel
-    (:data:`MODE_DRIVERS`) carries a line there (:func:`input_lines`), and the peak stands no
+    running median) are echoes of an input's line: a surface whose lines the channel can echo
+    (:data:`ECHO_DRIVERS`) carries a line there (:func:`input_lines`), and the peak stands no
     further above its median than the line does, within the scatter of two independent
     spectral estimates (the ratio of the two ratios tested as F(dof, dof) at
     :data:`ECHO_P`). The rigid body passes an input's line on to the output with a transfer
@@ -278,7 +283,7 @@ def echoes(ratio: np.ndarray, idx: np.ndarray, channel: str, lines: dict[str, np
     flexible mode rings far above the line that excites it (an F-16's 8 Hz mode at 2.9 times
     its median on a 1.8 times stabilator line)."""
     out = np.zeros(idx.size, dtype=bool)
-    for s in MODE_DRIVERS.get(channel, ()):
+    for s in ECHO_DRIVERS.get(channel, ()):
         line = lines.get(s)
         if line is None:
             continue

@@ -123,7 +123,13 @@ def withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatc
     (:func:`lift_change_on_cx`): at α ≈ 8.5° a C_Z,α change of −0.6 leaves a C_X mismatch
     following α·sin α that the stepwise named as a C_X α³ (52 ± 9, t 5.5) on a probe at
     6,000 ft and 380 ft/s. A C_X term is kept only if it stays significant (|t| >= the
-    entry t) with that share removed, as for a moment-reference shift's second axis."""
+    entry t) with that share removed, as for a moment-reference shift's second axis, and
+    beside the drag due to lift that the lift change carries (:func:`induced_drag_column`, its
+    factor k fitted, between 0 and :data:`MAX_INDUCED_DRAG_FACTOR`): a model whose drag reads
+    its total lift squared (JSBSim's ``aero/cl-squared``) drags more with the lift added. A
+    probe's F-4N (15,800 ft / 860 ft/s, pitch sweep) with a C_Z α² of −25 concealed as lift
+    had it named (−23 ± 4) and beside it a C_X α² of −0.64 (t −7.9): 2·0.14·C_L·ΔC_Z, the F-4N's
+    C_D,i = 0.14·C_L² at C_L ≈ 0.09 (probe seed 4128)."""
     named = [c for c in cands if c.selected and c.channel == "CZ" and c.test == "stepwise on the CZ mismatch"]
     if not named or "CZ" not in selections or "CX" not in selections:
         return
@@ -134,21 +140,59 @@ def withhold_explained_by_lift(cands: list[Candidate], selections: dict, mismatc
     inner = interior(p)
     delta_cz = sum(sel_z.params[k] * by_z[k].column for k in keys)
     z = mismatch["CX"][inner] - lift_change_on_cx(delta_cz, p.smooth["alpha"])[inner]
+    drag = induced_drag_column(delta_cz, p)[inner]
     sel, by_key = selections["CX"]
     chosen = [k for k in sel.names if k in by_key]
+    names = ", ".join(x.parameter for x in named)
     for c in cands:
         key = next((k for k in chosen if by_key[k].parameter == c.parameter), None)
         if not c.selected or c.channel != "CX" or key is None:
             continue
-        fit = _refit_term(z, [by_key[k].column[inner] for k in chosen if k != key], by_key[key].column[inner])
+        others = [by_key[k].column[inner] for k in chosen if k != key]
+        fit = _refit_term(z, others, by_key[key].column[inner])
         if fit is None:
             continue
         t = fit[1]
         if abs(t) < cand.T_IN:
             c.selected = False
-            c.reason = (f"entered, but explained by the C_Z change named ({', '.join(x.parameter for x in named)}) "
-                        f"read as a change of lift, whose share of C_X is −ΔC_Z tan α: with it removed, "
-                        f"t = {t:.1f}")
+            c.reason = (f"entered, but explained by the C_Z change named ({names}) read as a change of lift, whose "
+                        f"share of C_X is −ΔC_Z tan α: with it removed, t = {t:.1f}")
+            continue
+        polar = _beside_induced_drag(z, others, drag, by_key[key].column[inner])
+        if polar is not None and abs(polar[1]) < cand.T_IN and 0.0 < polar[0] <= MAX_INDUCED_DRAG_FACTOR:
+            c.selected = False
+            c.details["beside_induced_drag"] = {"k": polar[0], "t": polar[1]}
+            c.reason = (f"entered, but explained by the C_Z change named ({names}) read as a change of lift, which "
+                        f"the drag due to lift follows (ΔC_D = 2k·C_L·ΔC_L, k = {polar[0]:.3g}): beside it, "
+                        f"t = {polar[1]:.1f}")
+
+
+# The largest induced-drag factor k of C_D = C_D0 + k·C_L² a wing plausibly has: 1/(π e A)
+# with an aspect ratio A of 1 and an Oswald factor e of 0.5 (a slender delta; transport
+# wings lie near 0.04, fighters 0.1-0.3).
+MAX_INDUCED_DRAG_FACTOR = 0.64
+
+
+def induced_drag_column(delta_cz: np.ndarray, p: Prepared) -> np.ndarray:
+    """The body-axis C_X, per unit induced-drag factor k, that a lift change carries through
+    the drag due to lift (C_D = C_D0 + k·C_L², so ΔC_D = 2k·C_L·ΔC_L): ΔC_L = −ΔC_Z/cos α
+    (:func:`lift_change_on_cx`), ΔC_X = −ΔC_D cos α = 2k·C_L·ΔC_Z, C_L = −C_Z cos α + C_X sin α
+    from the recording's measured coefficients."""
+    a = np.asarray(p.smooth["alpha"], dtype=float)
+    lift = -p.measured["CZ"] * np.cos(a) + p.measured["CX"] * np.sin(a)
+    return 2.0 * lift * np.asarray(delta_cz, dtype=float)
+
+
+def _beside_induced_drag(z: np.ndarray, others: list[np.ndarray], drag: np.ndarray,
+                         column: np.ndarray) -> tuple[float, float] | None:
+    """The induced-drag factor k (:func:`induced_drag_column`'s coefficient) and ``column``'s t
+    fitted together on ``z`` beside ``others`` and a constant; None when dependent."""
+    try:
+        theta, se, _ = colored_fit(z, others + [drag, column], [f"o{i}" for i in range(len(others))] + ["k", "term"])
+    except (SingularRegressorsError, np.linalg.LinAlgError):
+        return None
+    j = len(others)
+    return float(theta[j]), (float(theta[j + 1] / se[j + 1]) if se[j + 1] > 0 else 0.0)
 
 
 def reference_arm_ft(trim) -> tuple[float, float]:
