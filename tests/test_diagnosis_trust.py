@@ -953,7 +953,7 @@ def test_a_v_scale_named_because_its_bias_was_left_out_is_withheld_when_the_bias
     bias and scale run to offsetting sizes together and the bias is left out as implausible;
     the scale named alone (0.05 at 160 ft/s) then reads as a bias of 7.6 ft/s, plausible
     (under 5 % of V): withheld. A scale whose bias was not left out, or whose offset no
-    plausible bias makes (0.08: 11.9 ft/s, over 5 %), stays named."""
+    plausible bias makes (0.12: 17.1 ft/s, over 5 % and over 10 kt), stays named."""
     from types import SimpleNamespace
 
     from harness.diagnosis.evidence import Candidate
@@ -971,9 +971,12 @@ def test_a_v_scale_named_because_its_bias_was_left_out_is_withheld_when_the_bias
     kept = scale(0.05)
     withhold_scale_a_bias_would_make([kept], SimpleNamespace(dropped={}), p)
     assert kept.selected
-    large = scale(0.08)
+    large = scale(0.12)
     withhold_scale_a_bias_would_make([large], left_out, p)
     assert large.selected
+    ten_knots = scale(0.08)  # 11.9 ft/s: over 5 % of V, under 10 kt (kinematics.AIRSPEED_ERROR_FLOOR_FPS)
+    withhold_scale_a_bias_would_make([ten_knots], left_out, p)
+    assert not ten_knots.selected
 
 
 def test_a_vane_bias_the_kinematics_name_is_sized_on_the_coefficient_means_too():
