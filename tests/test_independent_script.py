@@ -1243,6 +1243,32 @@ def test_the_drag_a_named_lift_change_carries_is_no_second_finding(tmp_path):
     assert "drag due to lift" in cx["reason"], cx["reason"]
 
 
+def test_a_rate_lag_the_kinematics_give_to_its_attitude_is_no_aileron_delay(tmp_path):
+    """The probe's seed 4167: an F-4N (15,000 ft / 583 ft/s, lateral 2-1-1s at 40 Hz) with p
+    62 ms late. The kinematics gave the relative skew to φ (−60 ms, t −11.7; p's own 29 ± 16 ms)
+    and an aileron delay of 64 ms was named. A lagging rate and its attitude leading are one skew
+    to them (term_rules.RATE_ATTITUDE): the delay is withheld and nothing is named."""
+    truth, result = _diagnosed_probe(4167, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "F4N" and truth["parameter"] == "skew_p"
+    assert _found(result) == []
+    delay = next(c for c in result["candidates"] if c["parameter"] == "tau_da")
+    assert "phi leading p" in delay["reason"], delay["reason"]
+
+
+@pytest.mark.parametrize("seed", [3769, 4169, 4197])
+def test_a_sensor_error_a_mode_under_the_search_floor_makes_is_not_named(tmp_path, seed):
+    """The probe's seeds 3769, 4169 and 4197: a noise-free T-37, an F-16 and an A-4 on lateral
+    maneuvers with a mode driven by the aileron ringing q and a_z at 3.8, 4.0 and 4.7 Hz, under
+    where the mode search starts (6 Hz, twice the motion's 3 Hz cut-off). An a_z skew of −68 ms and
+    β biases of 0.67° and 0.28° were named. The band between the motion's cut-off and the floor
+    shows the peak (spectra.sub_floor_peak); with it taken out as the aileron-driven mode the
+    kinematics keep none of them (mode_model.withhold_sensor_errors_a_peak_makes)."""
+    truth, result = _diagnosed_probe(seed, tmp_path, calibrate=False)
+    assert truth["parameter"] == "mode_frequency_hz" and truth["kind"] == "lateral"
+    assert _found(result) == []
+    assert any("under the mode search's floor" in c["reason"] for c in result["candidates"])
+
+
 def test_no_skew_of_a_rate_the_maneuver_did_not_drive(tmp_path):
     """The probe's seed 4016 (tests/probe/gen.py): a noise-free F-4N (20,300 ft / 650 ft/s,
     stabilator sweep at 50 Hz) with a 71 ms stabilator delay. The delay was named right and beside

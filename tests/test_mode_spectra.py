@@ -199,3 +199,34 @@ def test_a_mode_under_a_tenth_of_the_practical_bias_is_not_named():
     real = mode_candidate(PeakTest("q", 9.51, 0.05, 0.00096, 9.0, 1e-12, 0.029), True, "peak")
     assert real.selected and real.reason == "peak"
     assert 0.00096 > MODE_PRACTICAL_SHARE * PRACTICAL["bias"]["q"]
+
+
+def test_a_peak_under_the_search_floor_is_found_in_its_own_band():
+    """spectra.sub_floor_peak: a record whose motion ends at 2.9 Hz is searched for modes from
+    5.8 Hz (twice it); a 4 Hz line in q lies under that floor, is no structural peak, and is the
+    peak of the band between the two. A record with nothing there has none."""
+    rng = np.random.default_rng(6)
+    t = np.arange(N) / FS
+    q = 0.0015 * np.sin(2 * np.pi * 4.0 * t) + 0.002 * rng.normal(size=N)
+    rec = _record(q=q)
+    rec.common_cutoff_hz = 2.9
+    assert spectra.search_floor_hz(rec) == 2.0 * 2.9
+    above = spectra.structural_peak(rec)
+    assert above is None or above.p_value > spectra.FISHER_P
+    peak = spectra.sub_floor_peak(rec)
+    assert peak.p_value < spectra.FISHER_P and abs(peak.frequency_hz - 4.0) < 0.3
+    quiet = _record(q=0.002 * rng.normal(size=N))
+    quiet.common_cutoff_hz = 2.9
+    found = spectra.sub_floor_peak(quiet)
+    assert found is None or found.p_value > spectra.FISHER_P
+
+
+def test_notched_takes_a_line_out_of_the_rates_and_accelerations_only():
+    """spectra.notched: a 4 Hz line is taken out of q (to under 5 % of its amplitude) and the
+    surface is left as it was; a frequency beyond Nyquist changes nothing."""
+    t = np.arange(N) / FS
+    raw = {"q": np.sin(2 * np.pi * 4.0 * t), "de": np.sin(2 * np.pi * 4.0 * t)}
+    out = spectra.notched(raw, 1.0 / FS, 4.0)
+    assert np.std(out["q"][200:-200]) < 0.05 * np.std(raw["q"])
+    assert out["de"] is raw["de"]
+    assert spectra.notched(raw, 1.0 / FS, 30.0) is raw

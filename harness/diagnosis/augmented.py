@@ -10,7 +10,6 @@ from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
-from scipy import signal
 
 from harness.atomic import write_atomic, write_text_atomic
 from harness.diagnosis import candidates as cand
@@ -21,7 +20,7 @@ from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.fits import coefficient_fit, output_fit
 from harness.diagnosis.mode_model import driven_modes, mode_outputs, with_mode_band
 from harness.diagnosis.prepare import COEFFICIENTS, OUTPUTS, Prepared, prepare
-from harness.diagnosis.spectra import MODE_CHANNELS, gust_wind_ned
+from harness.diagnosis.spectra import MODE_CHANNELS, MODE_NOTCH_Q, gust_wind_ned, notched
 from harness.diagnosis.term_rules import IMITATION_SHARE
 from harness.diagnosis.validation import after_mismatch
 from harness.diagnosis.verdict import check_time_base
@@ -205,9 +204,6 @@ def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect
     return a, fit_b, fit_a, pd.DataFrame(series)
 
 
-# Quality factor of the sensor model's notch for a structural mode (bandwidth f0/Q): wide
-# enough for the mode's frequency uncertainty (a 2 s Welch segment resolves 0.5 Hz).
-MODE_NOTCH_Q = 8.0
 
 
 def _with_modes(sim: dict[str, np.ndarray], p: Prepared, modes: list) -> dict[str, np.ndarray]:
@@ -229,18 +225,10 @@ def _mode_notched(p: Prepared, findings: list[Candidate]) -> dict[str, np.ndarra
     (scipy.signal.iirnotch at its frequency, zero phase) in every rate and acceleration
     channel, so the raw fit after shows what the mode term removes. Returns ``p.raw``
     unchanged when there is no such mode."""
-    modes = [f for f in findings if f.effect == "structural_mode" and not f.details.get("mode_model")]
-    if not modes:
-        return p.raw
-    out = dict(p.raw)
-    fs = 1.0 / p.dt
-    for f in modes:
-        if not 0.0 < f.estimate < 0.5 * fs:
-            continue
-        b, a = signal.iirnotch(f.estimate, MODE_NOTCH_Q, fs=fs)
-        for c in MODE_CHANNELS:
-            if c in out:
-                out[c] = signal.filtfilt(b, a, out[c])
+    out = p.raw
+    for f in findings:
+        if f.effect == "structural_mode" and not f.details.get("mode_model"):
+            out = notched(out, p.dt, f.estimate)
     return out
 
 

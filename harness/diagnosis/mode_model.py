@@ -20,10 +20,11 @@ import numpy as np
 from scipy import ndimage, optimize, signal, stats
 
 from estimators.filter_error import MAD_TO_SIGMA
-from harness.diagnosis.kinematics import T_IN
+from harness.diagnosis.kinematics import T_IN, is_practical
 from harness.diagnosis.prepare import Prepared, interior_slice
-from harness.diagnosis.sensor_rules import kinematic_estimate, plausible_kinematic_check
-from harness.diagnosis.spectra import MODE_CHANNELS, MODE_DRIVERS
+from harness.diagnosis.sensor_rules import forced_entry_t, kinematic_estimate, plausible_kinematic_check
+from harness.diagnosis.spectra import FISHER_P, MODE_CHANNELS, MODE_DRIVERS, notched, sub_floor_peak
+from models.constants import SURFACES
 
 # The damping ratios tried before refinement (structural modes: 0.5-20 % of critical).
 DAMPING_GRID = np.geomspace(0.005, 0.2, 10)
@@ -178,14 +179,16 @@ def band_part(x: np.ndarray, dt: float, band_hz: tuple[float, float]) -> np.ndar
     return np.fft.irfft(X, n=len(x))
 
 
-def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float) -> DrivenMode | None:
+def fit_driven_mode(p: Prepared, channel: str, frequency_hz: float,
+                    drivers: tuple[str, ...] | None = None) -> DrivenMode | None:
     """The mode a spectral peak at ``frequency_hz`` in ``channel`` points to, fitted as the
     response to the surface that drives that channel (:data:`spectra.MODE_DRIVERS`) and
-    explains most of it, within :func:`_fit_band`; None when no recorded surface's response
-    explains it (p ≥ :data:`GAIN_P`): a mode rung by something the recording lacks
-    (turbulence, an engine) keeps the sensor model's notch."""
+    explains most of it, within :func:`_fit_band` (of ``drivers`` when given); None when no
+    recorded surface's response explains it (p ≥ :data:`GAIN_P`): a mode rung by something the
+    recording lacks (turbulence, an engine) keeps the sensor model's notch."""
     inner = interior_slice(p.n, p.dt)
-    surfaces = [s for s in MODE_DRIVERS.get(channel, ()) if s in p.raw and np.ptp(p.raw[s]) > 0]
+    drivers = MODE_DRIVERS.get(channel, ()) if drivers is None else drivers
+    surfaces = [s for s in drivers if s in p.raw and np.ptp(p.raw[s]) > 0]
     if channel not in p.raw or not surfaces or not 0.0 < frequency_hz < 0.45 / p.dt:
         return None
     if p.t[-1] < MIN_RECORD_S:  # a record the spectral test could not have named a mode on
@@ -332,6 +335,60 @@ def without_outputs(p: Prepared, outputs: dict[str, np.ndarray]) -> Prepared:
     smooth = p.smooth | {c: p.filt(raw[c]) for c in outputs}
     deriv = p.deriv | {c: p.differentiate(raw[c]) for c in outputs}
     return replace(p, raw=raw, smooth=smooth, deriv=deriv)
+
+
+def withhold_sensor_errors_a_peak_makes(findings: list, p: Prepared) -> list:
+    """The findings less the kinematic sensor errors (:data:`MODE_SENSOR_EFFECTS` and biases)
+    that the kinematics no longer take, at their entry t, with a spectral peak between the
+    motion's cut-off and the mode search's floor (:func:`spectra.sub_floor_peak`, p under
+    :data:`spectra.FISHER_P`) notched out of the identification maneuver ``p``'s rates and
+    accelerations (or leave it under the smallest size worth naming,
+    :func:`kinematics.is_practical`); each one withheld is deselected with the reason. The peak is taken out as a
+    notch (:func:`spectra.notched`) and as the response of each recorded surface whose fit
+    stands for it (:func:`fit_driven_mode`, :func:`acceptable`: a mode driven by a surface rings
+    below its resonance too, inside the maneuver's band, and on a two-surface input either may
+    fit the resonance best), an error any of them takes away being withheld.
+    No mode is named there (the maneuver's own motion falls through that band), but a mode
+    ringing there reaches the kinematic residuals through the products of the rates: a probe's
+    F-16 (489 ft/s, lateral sweeps) with a 3.96 Hz mode ringing a_z at 0.04 g (its search
+    starting at 6 Hz) had a β bias of 0.67° named (t 5.1), an A-4 (613 ft/s, lateral
+    multisine) with a 4.66 Hz mode one of 0.28° (t 5.9; probe seeds 4169 and 4197). Asked only
+    where no structural mode is among the findings."""
+    suspects = [f for f in findings if f.selected and f.test.startswith("kinematic")
+                and (f.effect in MODE_SENSOR_EFFECTS or f.effect == "sensor_bias")]
+    if not suspects or any(f.effect == "structural_mode" for f in findings):
+        return findings
+    peak = sub_floor_peak(p)
+    if peak is None or peak.p_value >= FISHER_P:
+        return findings
+    raw = notched(p.raw, p.dt, peak.frequency_hz)
+    removals = {"a notch": {c: p.raw[c] - raw[c] for c in MODE_CHANNELS if c in raw}}
+    for s in SURFACES:
+        mode = fit_driven_mode(p, peak.channel, peak.frequency_hz, (s,))
+        if acceptable(mode, peak.frequency_hz, peak.channel):
+            removals[f"a mode driven by {s}"] = mode_outputs(mode, p)
+    ts = {how: plausible_kinematic_check(without_outputs(p, outputs)) for how, outputs in removals.items()}
+    withheld = set()
+    for f in suspects:
+        entry = forced_entry_t(f.parameter, p) if f.effect == "sensor_bias" else T_IN
+        found = {how: kinematic_estimate(kin, f.parameter) for how, kin in ts.items()}
+        # what is left of it: its t where it is still practical (kinematics.is_practical), else 0
+        left = {h: 0.0 if x is None or not is_practical(f.parameter, x[0], p.dt) else x[1] for h, x in found.items()}
+        how = min(left, key=left.get)
+        t = left[how]
+        if t >= entry:
+            continue
+        f.selected = False
+        f.details["sub_floor_peak"] = {"channel": peak.channel, "frequency_hz": peak.frequency_hz,
+                                       "p_value": peak.p_value, "taken_out_as": how, "t": t}
+        f.reason = (f"not named: the {peak.channel} spectrum peaks at {peak.frequency_hz:.2f} Hz (p = "
+                    f"{peak.p_value:.1g}), under the mode search's floor, where a mode cannot be told from the "
+                    f"maneuver's own motion; with that peak taken out of the rates and accelerations as {how} the "
+                    f"kinematics " + (f"stand this at t = {t:.1f}, under their entry t" if found[how] is not None
+                                      and is_practical(f.parameter, found[how][0], p.dt) else
+                                      "leave none of it worth naming") + f" (it had been: {f.reason})")
+        withheld.add(id(f))
+    return [f for f in findings if id(f) not in withheld]
 
 
 # The tests whose terms are read off the coefficient mismatch (stepwise_axes, candidates).

@@ -21,7 +21,7 @@ from harness.diagnosis.evidence import Analysis, Candidate
 from harness.diagnosis.fcs_surfaces import choose_secondary_surfaces
 from harness.diagnosis.limits import detection_limits
 from harness.diagnosis.mode_model import (attach_mode_models, withhold_sensor_errors_a_mode_makes,
-                                         withhold_terms_a_mode_makes)
+                                          withhold_sensor_errors_a_peak_makes, withhold_terms_a_mode_makes)
 from harness.diagnosis.prepare import instruments_at_cg, prepare
 from harness.diagnosis.reference_point import choose_reference_point, withhold_shift_between_placements
 from harness.diagnosis.replication import lift_unreplicated_suspicions, name_mode_on_both, name_replicated
@@ -252,6 +252,7 @@ def _diagnose(model: str, recording: str | Path, out: Path, validation: str | Pa
     findings, unconfirmed, checks = _checked(a, av)
     attach_mode_models(findings, {"identification": p} | ({"validation": pv} if av is not None else {}))
     findings = withhold_sensor_errors_a_mode_makes(findings, p)
+    findings = withhold_sensor_errors_a_peak_makes(findings, p)
     findings = withhold_terms_a_mode_makes(findings, p, lambda quiet: analyse(quiet, aircraft, ic))
     modelled = list(findings)
     added = terms_of(modelled, a.applied)

@@ -80,10 +80,10 @@ def welch_dof(n: int, nperseg: int) -> float:
 
 
 def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
-                    half_width_hz: float = 2.5) -> PeakTest | None:
+                    half_width_hz: float = 2.5, band_hz: tuple[float, float] | None = None) -> PeakTest | None:
     """The most significant peak in what the motion leaves of each rate and acceleration
     channel (:func:`mode_residual`), above :func:`search_floor_hz` (where the maneuver itself
-    has little power).
+    has little power), or within ``band_hz`` when given (:func:`sub_floor_peak`).
 
     The spectrum is Welch's (Hann, ``segment_s`` segments, 50 % overlap): averaging makes a
     lightly damped mode, rung by each input and decaying within a second or two, a peak a
@@ -107,7 +107,8 @@ def structural_peak(p: Prepared, f_min_hz: float = 2.0, segment_s: float = 2.0,
         f, P, med, w = _median_spectrum(x, fs, nper, half_width_hz)
         df = f[1] - f[0]
         # the top 10 % below Nyquist is left out: the median window is one-sided there
-        band = (f >= search_floor_hz(p, f_min_hz)) & (f <= 0.9 * f[-1])
+        low, high = band_hz if band_hz is not None else (search_floor_hz(p, f_min_hz), 0.9 * f[-1])
+        band = (f >= low) & (f <= min(high, 0.9 * f[-1]))
         if band.sum() < 2 * w:
             continue
         idx = np.flatnonzero(band & local_maxima(P))
@@ -208,6 +209,41 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
         return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or {MOTION_POWER_FACTOR:g} times "
                 f"its motion's cut-off of {cut:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
     return ""
+
+
+def sub_floor_peak(p: Prepared, f_min_hz: float = 2.0) -> PeakTest | None:
+    """The most significant peak (:func:`structural_peak`, its running median within
+    :data:`SUB_FLOOR_HALF_WIDTH_HZ`) between the motion's cut-off (:func:`motion_cutoff_hz`,
+    at least ``f_min_hz``) and the mode search's floor (:func:`search_floor_hz`): where a mode
+    and the maneuver's own motion cannot be told apart, so none is named there, but a sensor
+    error the kinematics read there is suspect
+    (:func:`mode_model.withhold_sensor_errors_a_peak_makes`). None when that band is empty."""
+    low, high = max(f_min_hz, motion_cutoff_hz(p)), search_floor_hz(p, f_min_hz)
+    if high <= low:
+        return None
+    return structural_peak(p, f_min_hz, half_width_hz=SUB_FLOOR_HALF_WIDTH_HZ, band_hz=(low, high))
+
+
+# The running median's half-width in :func:`sub_floor_peak`: its band is a few hertz wide
+# (3-6 Hz at the widest), under the two windows :func:`structural_peak` needs at 2.5 Hz.
+SUB_FLOOR_HALF_WIDTH_HZ = 1.5
+
+
+# Quality factor of the sensor model's notch for a structural mode (bandwidth f0/Q): wide
+# enough for the mode's frequency uncertainty (a 2 s Welch segment resolves 0.5 Hz).
+MODE_NOTCH_Q = 8.0
+
+
+def notched(raw: dict[str, np.ndarray], dt: float, frequency_hz: float) -> dict[str, np.ndarray]:
+    """Channels ``raw`` (sample interval ``dt``) with their rates and accelerations
+    (:data:`MODE_CHANNELS`) notched at ``frequency_hz`` (scipy.signal.iirnotch,
+    :data:`MODE_NOTCH_Q`, zero phase); ``raw`` unchanged when the frequency lies outside
+    (0, Nyquist)."""
+    fs = 1.0 / dt
+    if not 0.0 < frequency_hz < 0.5 * fs:
+        return raw
+    b, a = signal.iirnotch(frequency_hz, MODE_NOTCH_Q, fs=fs)
+    return raw | {c: signal.filtfilt(b, a, raw[c]) for c in MODE_CHANNELS if c in raw}
 
 
 def motion_cutoff_hz(p: Prepared) -> float:

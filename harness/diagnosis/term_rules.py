@@ -795,6 +795,12 @@ DEPENDENT_SENSOR = {"CX": "ax", "CY": "ay", "CZ": "az", "Cl": "p", "Cm": "q", "C
 # The rate each surface mainly drives: a time skew of that rate's channel makes the surface
 # look late by the same amount.
 SURFACE_RATE = {"de": "q", "da": "p", "dr": "r"}
+# The attitude each rate integrates to (φ̇ = p, θ̇ = q at small angles): a lagging rate and an
+# attitude leading it by the same time are one relative skew to the kinematics, which may give
+# it to either. A probe's F-4N (583 ft/s, lateral 2-1-1s at 40 Hz) with p 62 ms late had a φ
+# skew of −60 ms (t −11.7) fitted, p's own at 29 ± 16 ms, and an aileron delay of 64 ms named
+# (probe seed 4167).
+RATE_ATTITUDE = {"p": "phi", "q": "theta"}
 
 
 def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
@@ -805,7 +811,8 @@ def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
     standard errors of the delay (both estimates' errors combined: they do not rule a skew of
     that size out), or shows (|t| >= :data:`AMBIGUOUS_T`, same sign) within 30 % of it. A
     skew the kinematics could not test (the rate hardly moves) leaves the delay named, with
-    the caveat in ``details['not_ruled_out']``."""
+    the caveat in ``details['not_ruled_out']``. The attitude the rate integrates to
+    (:data:`RATE_ATTITUDE`) leading by the delay is the same relative skew and is asked too."""
     rate = SURFACE_RATE.get(c.channel, "")
     name = f"skew_{rate}"
     found = kinematic_estimate(kin, name)
@@ -813,17 +820,24 @@ def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
         c.details["not_ruled_out"] = (f"a {rate}-gyro lag of the same size would look alike; the kinematic check did "
                                       f"not test one ({name} not offered)")
         return
-    skew, t = found
-    se_skew = kinematic_std_error(kin, name)
-    se_diff = float(np.hypot(c.std_error, se_skew))
-    gap = abs(skew - c.estimate)
-    shows = t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and gap <= 0.3 * abs(c.estimate)
-    if gap <= 2.0 * se_diff or shows:
-        c.selected = False
-        c.details["sensor_rival"] = name
-        c.reason = (f"entered, but not named: the kinematics show the {rate} channel lagging by {skew:.3f} ± "
-                    f"{se_skew:.3f} s ({name}, t = {t:.1f}), which "
-                    + ("looks like this delay" if t >= AMBIGUOUS_T else "does not rule out a lag of this size"))
+    attitude = RATE_ATTITUDE.get(rate, "")
+    for skew_name, sign in ((name, 1.0), (f"skew_{attitude}", -1.0)):
+        found = kinematic_estimate(kin, skew_name) if skew_name != "skew_" else None
+        if found is None:
+            continue
+        skew, t = sign * found[0], found[1]
+        se_skew = kinematic_std_error(kin, skew_name)
+        gap = abs(skew - c.estimate)
+        shows = t >= AMBIGUOUS_T and np.sign(skew) == np.sign(c.estimate) and gap <= 0.3 * abs(c.estimate)
+        if gap <= 2.0 * float(np.hypot(c.std_error, se_skew)) or shows:
+            c.selected = False
+            c.details["sensor_rival"] = skew_name
+            lag = (f"the {rate} channel lagging by {skew:.3f} ± {se_skew:.3f} s ({skew_name}, t = {t:.1f})"
+                   if sign > 0 else f"{attitude} leading {rate} by {skew:.3f} ± {se_skew:.3f} s ({skew_name}, "
+                   f"t = {t:.1f}: to the kinematics the same as {rate} lagging)")
+            c.reason = (f"entered, but not named: the kinematics show {lag}, which "
+                        + ("looks like this delay" if t >= AMBIGUOUS_T else "does not rule out a lag of this size"))
+            return
 
 
 # A suspected sensor error withholds a term only if, anywhere within IMITATION_Z standard
