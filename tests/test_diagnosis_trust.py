@@ -1224,7 +1224,9 @@ def _lift_case(extra_cx: float):
                        "stepwise on the CX mismatch", True, "entered"),
              Candidate("coefficient_error", "axial", "CX", "CX_own", extra_cx, 1e-5, 50.0, 0.5, "1",
                        "stepwise on the CX mismatch", bool(extra_cx), "entered")]
-    return cands, selections, {"CX": cx, "CZ": cz}, SimpleNamespace(smooth={"alpha": alpha}, dt=dt, n=n)
+    measured = {"CZ": -(0.3 + 5.0 * alpha), "CX": np.full(n, -0.03)}
+    return cands, selections, {"CX": cx, "CZ": cz}, SimpleNamespace(smooth={"alpha": alpha}, dt=dt, n=n,
+                                                                    measured=measured)
 
 
 def test_a_cx_term_that_a_named_lift_change_explains_is_withheld():
@@ -1244,6 +1246,44 @@ def test_a_cx_term_that_a_named_lift_change_explains_is_withheld():
     alpha3, own = cands[1], cands[2]
     assert not alpha3.selected and "change of lift" in alpha3.reason
     assert own.selected and own.reason == "entered"
+
+
+@pytest.mark.parametrize("k", [0.14, -0.14])
+def test_a_cx_term_the_drag_due_to_a_named_lift_change_explains_is_withheld(k):
+    """term_rules.induced_drag_column: a C_Z α² change of −25 concealed as lift at α 1° ± 2°
+    (C_L 0.09 + 3.6 Δα), the model's drag reading the total lift squared (k = 0.14) puts
+    2k·C_L·ΔC_Z on C_X, which the stepwise takes as a C_X α² term; beside the column it falls
+    under the entry t and is withheld, its k recovered. Drag falling with lift (k < 0) is no
+    induced drag: the term stays named."""
+    from types import SimpleNamespace
+
+    from harness.diagnosis.evidence import Candidate
+    from harness.diagnosis.term_rules import withhold_explained_by_lift
+    n, dt = 1500, 0.02
+    t = np.arange(n) * dt
+    rng = np.random.default_rng(8)
+    da = 0.035 * np.sin(2 * np.pi * 0.3 * t) * np.sin(2 * np.pi * 0.05 * t)
+    alpha = 0.0175 + da
+    cl = 0.09 + 3.6 * da
+    dcz = -25.0 * da ** 2
+    cx = -dcz * np.tan(alpha) + 2.0 * k * cl * dcz + 1e-5 * rng.standard_normal(n)  # the lift's share, its drag
+    term = lambda par, col: SimpleNamespace(parameter=par, column=col, scale=1.0)  # noqa: E731
+    selections = {"CZ": (SimpleNamespace(names=("alpha2",), params={"alpha2": -25.0}),
+                         {"alpha2": term("CZ_alpha2", da ** 2)}),
+                  "CX": (SimpleNamespace(names=("alpha2",), params={}), {"alpha2": term("CX_alpha2", da ** 2)})}
+    cands = [Candidate("nonlinear_alpha", "normal", "CZ", "CZ_alpha2", -25.0, 1.0, -25.0, 0.5, "per rad^2",
+                       "stepwise on the CZ mismatch", True, "entered"),
+             Candidate("nonlinear_alpha", "axial", "CX", "CX_alpha2", 2.0 * k * 0.09 * -25.0, 0.01, -60.0, 0.5,
+                       "per rad^2", "stepwise on the CX mismatch", True, "entered")]
+    measured = {"CZ": -cl * np.cos(alpha), "CX": cl * np.sin(alpha)}
+    p = SimpleNamespace(smooth={"alpha": alpha}, dt=dt, n=n, measured=measured)
+    withhold_explained_by_lift(cands, selections, {"CX": cx, "CZ": -cl * np.cos(alpha) + dcz}, p)
+    cx_term = cands[1]
+    if k > 0:
+        assert not cx_term.selected and "drag due to lift" in cx_term.reason
+        assert cx_term.details["beside_induced_drag"]["k"] == pytest.approx(k, rel=0.05)
+    else:
+        assert cx_term.selected
 
 
 def _drift_case(along_vane_size: float, monkeypatch):
