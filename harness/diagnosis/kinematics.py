@@ -298,9 +298,9 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
                                               f"noise level): a {kind} cannot be told from noise")
         elif (c in DRIVEN_BY and c not in p.driven and moves < MIN_EXCITATION * PRACTICAL["bias"][c]
               and columns.pop(f"skew_{c}", None) is not None):
-            dropped[f"skew_{c}"] = (f"{c} hardly moves and the maneuver did not drive it ({moves:.3g} {UNITS[c]}, under "
-                                    f"{MIN_EXCITATION:g} times the smallest {c} bias worth naming): a skew of it would "
-                                    "be no practical error")
+            dropped[f"skew_{c}"] = (f"{c} hardly moves and the maneuver did not drive it ({moves:.3g} {UNITS[c]}, "
+                                    f"under {MIN_EXCITATION:g} times the smallest {c} bias worth naming): a skew of it "
+                                    "would be no practical error")
     for c in SCALE_CHANNELS:
         s, b = columns.get(f"scale_{c}"), columns.get(f"bias_{c}")
         if s is not None and b is not None and np.ptp(s) > 0 and np.ptp(b) > 0:

@@ -203,11 +203,13 @@ def untestable_at(p: Prepared, channel: str, frequency_hz: float, segment_s: flo
     low = search_floor_hz(p, f_min_hz)
     cut = motion_cutoff_hz(p)
     if low >= 0.45 * fs:
-        return (f"it has no spectral band to search: {MOTION_POWER_FACTOR:g} times its motion's cut-off of {cut:.1f} Hz "
-                f"lies above 0.9 of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping everything below as motion")
+        return (f"it has no spectral band to search: {MOTION_POWER_FACTOR:g} times its motion's cut-off of "
+                f"{cut:.1f} Hz lies above 0.9 of Nyquist ({0.45 * fs:.1f} Hz), its smoothing keeping everything "
+                "below as motion")
     if not low <= frequency_hz <= 0.9 * 0.5 * fs:
-        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or {MOTION_POWER_FACTOR:g} times "
-                f"its motion's cut-off of {cut:.1f} Hz, whichever is higher, up to 0.9 of Nyquist)")
+        return (f"its spectral band is {low:.1f}-{0.45 * fs:.1f} Hz (from {f_min_hz:g} Hz or "
+                f"{MOTION_POWER_FACTOR:g} times its motion's cut-off of {cut:.1f} Hz, whichever is higher, up to 0.9 "
+                "of Nyquist)")
     return ""
 
 
