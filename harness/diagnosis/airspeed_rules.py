@@ -59,7 +59,8 @@ def withhold_on_the_airspeed(cands: list[Candidate], p: Prepared, kin: Kinematic
     (:func:`airspeed_signature`) in the term's place (with the axis's other selected terms and
     its nuisance columns); when the airspeed error so sized is one an instrument could make
     (within :data:`kinematics.PLAUSIBLE`'s 10 % of V for an airspeed scale, which over a
-    maneuver that hardly moves V is the same error, or :data:`kinematics.AIRSPEED_ERROR_FLOOR_FPS`) and lies within
+    maneuver that hardly moves V is the same error, or
+    :data:`kinematics.AIRSPEED_ERROR_FLOOR_FPS`) and lies within
     :data:`term_rules.IMITATION_Z` standard errors of the kinematics' bias estimate (the two
     estimates' colored standard errors taken together, as independent), and the term fitted
     beside the signature falls below the entry t (:data:`candidates.T_IN`), it is withheld.

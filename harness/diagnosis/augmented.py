@@ -204,8 +204,6 @@ def fly_maneuver_pair(p: Prepared, aircraft: Aircraft, added: tuple[HiddenEffect
     return a, fit_b, fit_a, pd.DataFrame(series)
 
 
-
-
 def _with_modes(sim: dict[str, np.ndarray], p: Prepared, modes: list) -> dict[str, np.ndarray]:
     """The replay's outputs with each driven mode's response (:mod:`harness.diagnosis.mode_model`)
     added to the outputs it rings in."""

@@ -339,21 +339,21 @@ def without_outputs(p: Prepared, outputs: dict[str, np.ndarray]) -> Prepared:
 
 def withhold_sensor_errors_a_peak_makes(findings: list, p: Prepared) -> list:
     """The findings less the kinematic sensor errors (:data:`MODE_SENSOR_EFFECTS` and biases)
-    that the kinematics no longer take, at their entry t, with a spectral peak between the
-    motion's cut-off and the mode search's floor (:func:`spectra.sub_floor_peak`, p under
-    :data:`spectra.FISHER_P`) notched out of the identification maneuver ``p``'s rates and
-    accelerations (or leave it under the smallest size worth naming,
-    :func:`kinematics.is_practical`); each one withheld is deselected with the reason. The peak is taken out as a
-    notch (:func:`spectra.notched`) and as the response of each recorded surface whose fit
-    stands for it (:func:`fit_driven_mode`, :func:`acceptable`: a mode driven by a surface rings
-    below its resonance too, inside the maneuver's band, and on a two-surface input either may
-    fit the resonance best), an error any of them takes away being withheld.
-    No mode is named there (the maneuver's own motion falls through that band), but a mode
-    ringing there reaches the kinematic residuals through the products of the rates: a probe's
-    F-16 (489 ft/s, lateral sweeps) with a 3.96 Hz mode ringing a_z at 0.04 g (its search
-    starting at 6 Hz) had a β bias of 0.67° named (t 5.1), an A-4 (613 ft/s, lateral
-    multisine) with a 4.66 Hz mode one of 0.28° (t 5.9; probe seeds 4169 and 4197). Asked only
-    where no structural mode is among the findings."""
+    that a spectral peak between the motion's cut-off and the mode search's floor
+    (:func:`spectra.sub_floor_peak`, p under :data:`spectra.FISHER_P`) makes; each one withheld
+    is deselected with the reason. Asked only where no structural mode is among the findings.
+
+    No mode is named in that band (the maneuver's own motion falls through it), but a mode
+    ringing there reaches the kinematic residuals through the products of the rates. The peak
+    is taken out of the identification maneuver ``p``'s rates and accelerations as a notch
+    (:func:`spectra.notched`) and as the response of each recorded surface whose fit stands for
+    it (:func:`fit_driven_mode`, :func:`acceptable`: a mode driven by a surface rings below its
+    resonance too, inside the maneuver's band, and on a two-surface input either may fit the
+    resonance best). An error that any of these leaves under its entry t, or under the smallest
+    size worth naming (:func:`kinematics.is_practical`), is withheld. A probe's F-16 (489 ft/s,
+    lateral sweeps) with a 3.96 Hz mode ringing a_z at 0.04 g (its search starting at 6 Hz) had
+    a β bias of 0.67° named (t 5.1), an A-4 (613 ft/s, lateral multisine) with a 4.66 Hz mode
+    one of 0.28° (t 5.9; probe seeds 4169 and 4197)."""
     suspects = [f for f in findings if f.selected and f.test.startswith("kinematic")
                 and (f.effect in MODE_SENSOR_EFFECTS or f.effect == "sensor_bias")]
     if not suspects or any(f.effect == "structural_mode" for f in findings):
@@ -367,15 +367,14 @@ def withhold_sensor_errors_a_peak_makes(findings: list, p: Prepared) -> list:
         mode = fit_driven_mode(p, peak.channel, peak.frequency_hz, (s,))
         if acceptable(mode, peak.frequency_hz, peak.channel):
             removals[f"a mode driven by {s}"] = mode_outputs(mode, p)
-    ts = {how: plausible_kinematic_check(without_outputs(p, outputs)) for how, outputs in removals.items()}
+    checks = {how: plausible_kinematic_check(without_outputs(p, outputs)) for how, outputs in removals.items()}
     withheld = set()
     for f in suspects:
         entry = forced_entry_t(f.parameter, p) if f.effect == "sensor_bias" else T_IN
-        found = {how: kinematic_estimate(kin, f.parameter) for how, kin in ts.items()}
-        # what is left of it: its t where it is still practical (kinematics.is_practical), else 0
-        left = {h: 0.0 if x is None or not is_practical(f.parameter, x[0], p.dt) else x[1] for h, x in found.items()}
-        how = min(left, key=left.get)
-        t = left[how]
+        left = {how: _what_is_left(kinematic_estimate(kin, f.parameter), f.parameter, p.dt)
+                for how, kin in checks.items()}
+        how = min(left, key=lambda h: left[h][0])
+        t, said = left[how]
         if t >= entry:
             continue
         f.selected = False
@@ -384,11 +383,17 @@ def withhold_sensor_errors_a_peak_makes(findings: list, p: Prepared) -> list:
         f.reason = (f"not named: the {peak.channel} spectrum peaks at {peak.frequency_hz:.2f} Hz (p = "
                     f"{peak.p_value:.1g}), under the mode search's floor, where a mode cannot be told from the "
                     f"maneuver's own motion; with that peak taken out of the rates and accelerations as {how} the "
-                    f"kinematics " + (f"stand this at t = {t:.1f}, under their entry t" if found[how] is not None
-                                      and is_practical(f.parameter, found[how][0], p.dt) else
-                                      "leave none of it worth naming") + f" (it had been: {f.reason})")
+                    f"kinematics {said} (it had been: {f.reason})")
         withheld.add(id(f))
     return [f for f in findings if id(f) not in withheld]
+
+
+def _what_is_left(found: tuple[float, float] | None, name: str, dt: float) -> tuple[float, str]:
+    """A kinematic estimate's |t| where it is still worth naming (0 where it is gone or under
+    :func:`kinematics.is_practical`), and what the kinematics then say of it."""
+    if found is None or not is_practical(name, found[0], dt):
+        return 0.0, "leave none of it worth naming"
+    return found[1], f"stand this at t = {found[1]:.1f}, under their entry t"
 
 
 # The tests whose terms are read off the coefficient mismatch (stepwise_axes, candidates).

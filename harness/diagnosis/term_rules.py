@@ -820,9 +820,9 @@ def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
         c.details["not_ruled_out"] = (f"a {rate}-gyro lag of the same size would look alike; the kinematic check did "
                                       f"not test one ({name} not offered)")
         return
-    attitude = RATE_ATTITUDE.get(rate, "")
-    for skew_name, sign in ((name, 1.0), (f"skew_{attitude}", -1.0)):
-        found = kinematic_estimate(kin, skew_name) if skew_name != "skew_" else None
+    asked = [(name, 1.0)] + ([(f"skew_{RATE_ATTITUDE[rate]}", -1.0)] if rate in RATE_ATTITUDE else [])
+    for skew_name, sign in asked:
+        found = kinematic_estimate(kin, skew_name)
         if found is None:
             continue
         skew, t = sign * found[0], found[1]
@@ -833,8 +833,8 @@ def _withhold_skewed_delay(c: Candidate, kin: KinematicResult) -> None:
             c.selected = False
             c.details["sensor_rival"] = skew_name
             lag = (f"the {rate} channel lagging by {skew:.3f} ± {se_skew:.3f} s ({skew_name}, t = {t:.1f})"
-                   if sign > 0 else f"{attitude} leading {rate} by {skew:.3f} ± {se_skew:.3f} s ({skew_name}, "
-                   f"t = {t:.1f}: to the kinematics the same as {rate} lagging)")
+                   if sign > 0 else f"{RATE_ATTITUDE[rate]} leading {rate} by {skew:.3f} ± {se_skew:.3f} s "
+                   f"({skew_name}, t = {t:.1f}: to the kinematics the same as {rate} lagging)")
             c.reason = (f"entered, but not named: the kinematics show {lag}, which "
                         + ("looks like this delay" if t >= AMBIGUOUS_T else "does not rule out a lag of this size"))
             return
