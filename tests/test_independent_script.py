@@ -1255,6 +1255,22 @@ def test_a_rate_lag_the_kinematics_give_to_its_attitude_is_no_aileron_delay(tmp_
     assert "phi leading p" in delay["reason"], delay["reason"]
 
 
+@pytest.mark.parametrize("seed", [4264, 4316])
+def test_a_control_change_an_unoffered_alphadot_term_would_make_is_not_named(tmp_path, seed):
+    """The probe's seeds 4264 and 4316: a c182 (pitch doublets) and a J3 Cub (2-1-1) at 1.8 and
+    twice the noise with C_m,α̇ −11.7 and −8.2. α never moved above its vane's noise, so no α̇
+    term was offered, and C_m,δe −0.55 and −0.79 were named (t 22.6, 14.1) for what the kinematic
+    α̇ column carries: beside it their t fall to 0.9 and 0.1
+    (term_rules.withhold_beside_the_unoffered_alphadot). Nothing is named, and the verdict says a
+    term was withheld, not that the mismatch is noise."""
+    truth, result = _diagnosed_probe(seed, tmp_path, calibrate=False)
+    assert truth["parameter"] == "Cm_alphadot" and truth["kind"] == "pitch"
+    assert _found(result) == []
+    de = next(c for c in result["candidates"] if c["parameter"] == "Cm_de")
+    assert "not offered because α never moved above its noise" in de["reason"], de["reason"]
+    assert result["findings"][0]["explanation"].startswith("No effect is named: ")
+
+
 @pytest.mark.parametrize("seed", [3769, 4169, 4197])
 def test_a_sensor_error_a_mode_under_the_search_floor_makes_is_not_named(tmp_path, seed):
     """The probe's seeds 3769, 4169 and 4197: a noise-free T-37, an F-16 and an A-4 on lateral

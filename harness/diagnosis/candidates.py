@@ -81,6 +81,12 @@ def alpha_rate(p: Prepared, axis: str = "Cm") -> np.ndarray:
     return kinematic_alpha_rate(p.smooth)
 
 
+def alphadot_column(p: Prepared, axis: str) -> np.ndarray:
+    """The regressor of an unsteady α̇ term of ``axis``: α̇ c̄/2V (effects.md's
+    unsteady_alphadot), α̇ from :func:`alpha_rate`."""
+    return alpha_rate(p, axis) * p.meta["geometry"]["cbar_ft"] / (2.0 * p.smooth["V"])
+
+
 def effective_derivatives(p: Prepared, axis: str, model: np.ndarray) -> dict[str, float]:
     """The model's own derivatives of ``axis`` over this maneuver: its coefficient along the
     recorded states regressed on the axis's own regressors (and a constant). Equal to the
@@ -148,9 +154,8 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
                                        "trim_value": derivatives.get(f"{axis}_{r}", float("nan"))},
                               sources=(REGRESSOR_SOURCE[r],)))
     if axis in LON:
-        adot = alpha_rate(p, axis) * geo["cbar_ft"] / (2.0 * p.smooth["V"])
-        terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)", adot,
-                          sources=("alpha",)))
+        terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)",
+                          alphadot_column(p, axis), sources=("alpha",)))
         terms.append(Term("alpha2", "nonlinear_alpha", f"{axis}_alpha2", "per rad^2", a ** 2, sources=("alpha",)))
         terms.append(Term("alpha3", "nonlinear_alpha", f"{axis}_alpha3", "per rad^3", a ** 3, sources=("alpha",)))
     else:

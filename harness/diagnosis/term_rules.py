@@ -617,6 +617,49 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                                             slope_of, p, inner)
 
 
+def withhold_beside_the_unoffered_alphadot(cands: list[Candidate], step: StepwiseFits, mismatch: dict[str, np.ndarray],
+                                           p: Prepared) -> None:
+    """Deselect a longitudinal term the α̇ term, not offered on its axis (α never moved above
+    its noise, :func:`candidates.offered`), would replace: its column correlated with α̇'s by
+    at least :data:`rivals.TERM_RIVAL_CORRELATION` and the term under the entry t
+    (:data:`candidates.T_IN`) beside it. The α̇ column is the kinematic one, from the gyros and
+    accelerometers, so it follows a short pulse's response even where the vane's α stays
+    within its noise; it could not be named there, but neither can what it imitates. An
+    independent script's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with
+    C_m,α̇ −11.7 had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the α̇ column
+    (r −0.92) its t fell to 0.9, α̇'s stood at −13.6. A J3 Cub (2-1-1, twice the noise) with
+    C_m,α̇ −8.2 had C_m,δe −0.79 named the same way (beside α̇, t 0.1)."""
+    inner = interior(p)
+    for c in cands:
+        if not (c.selected and c.channel in cand.LON and c.channel in step.selections
+                and any(d["parameter"] == f"{c.channel}_alphadot" for d in step.not_offered.get(c.channel, ()))):
+            continue
+        sel, by_key = step.selections[c.channel]
+        key = next((k for k, t in by_key.items() if t.parameter == c.parameter and k in sel.names), None)
+        if key is None:
+            continue
+        column, adot = by_key[key].column[inner], cand.alphadot_column(p, c.channel)[inner]
+        if np.ptp(column) <= 0 or np.ptp(adot) <= 0:
+            continue
+        r = float(np.corrcoef(column, adot)[0, 1])
+        if abs(r) < rivals.TERM_RIVAL_CORRELATION:
+            continue
+        nuisance = [col[inner] for col in step.nuisances.get(c.channel, {}).values() if np.ptp(col[inner]) > 0]
+        others = [by_key[n].column[inner] for n in sel.names if n != key and n in by_key] + nuisance
+        try:
+            t_term, t_adot = rivals.t_pair(mismatch[c.channel][inner], others, column, adot)
+        except (SingularRegressorsError, np.linalg.LinAlgError):
+            t_term, t_adot = 0.0, 0.0
+        if abs(t_term) >= cand.T_IN:
+            continue
+        c.selected = False
+        c.details["unoffered_rival"] = {"parameter": f"{c.channel}_alphadot", "effect": "unsteady_alphadot",
+                                        "correlation": r, "t_term": t_term, "t_rival": t_adot}
+        c.reason = (f"entered, but not named: an α̇ term, not offered because α never moved above its noise, "
+                    f"would explain it as well (columns correlated {r:+.2f}; beside it, t = {t_term:.1f}, the α̇ "
+                    f"term's t = {t_adot:.1f})")
+
+
 def withhold_for_an_unchecked_scale(c: Candidate, sources: tuple[str, ...], kin: KinematicResult, z: np.ndarray,
                                     column: np.ndarray, others: list[np.ndarray], slope_of, p: Prepared,
                                     inner: slice) -> None:

@@ -301,11 +301,27 @@ def none_finding(a: Analysis, fits_b: dict) -> dict:
                 "strongest_candidates": [{"effect": c.effect, "parameter": c.parameter, "t": c.t,
                                           "explained_fraction": c.explained_fraction, "reason": c.reason} for c in top],
                 "entry_t": cand.T_IN, "mismatch_to_noise": ratios},
-            "fit_before": fits_b, "fit_after": fits_b,
-            "explanation": "No candidate effect is both significant against the noise the data themselves show "
-                           f"and large enough to matter (at least {100 * cand.PRACTICAL_SHARE:.0f} % of its "
-                           "coefficient's excursion): the mismatch is explained by measurement noise alone, within "
-                           "what this maneuver could test (see not_checked)."}
+            "fit_before": fits_b, "fit_after": fits_b, "explanation": _none_text(a.candidates)}
+
+
+def _none_text(cands: list) -> str:
+    """The ``none`` verdict's explanation: noise alone, or, where terms entered the fit but
+    were withheld for what would imitate them, that the data could not tell which (the
+    strongest of them with its reason), never that noise explains it."""
+    withheld = sorted((c for c in cands if c.reason.startswith("entered, but")), key=lambda c: -abs(c.t))
+    if not withheld:
+        return ("No candidate effect is both significant against the noise the data themselves show and large "
+                f"enough to matter (at least {100 * cand.PRACTICAL_SHARE:.0f} % of its coefficient's excursion): "
+                "the mismatch is explained by measurement noise alone, within what this maneuver could test "
+                "(see not_checked).")
+    first = withheld[0]
+    why = first.reason.split(":", 1)[-1].strip()
+    return (f"No effect is named: {len(withheld)} candidate{'s' if len(withheld) > 1 else ''} entered the fit "
+            f"but {'were' if len(withheld) > 1 else 'was'} withheld because the data cannot tell "
+            f"{'them' if len(withheld) > 1 else 'it'} from something else that would imitate "
+            f"{'them' if len(withheld) > 1 else 'it'} (the strongest, {first.parameter} at t = {first.t:.1f}: {why}). "
+            "A maneuver that separates the two is needed to say which; see not_checked for what this one "
+            "could not test.")
 
 
 # The factor by which the model's lift along the recorded states may differ from the
