@@ -1255,6 +1255,19 @@ def test_a_rate_lag_the_kinematics_give_to_its_attitude_is_no_aileron_delay(tmp_
     assert "phi leading p" in delay["reason"], delay["reason"]
 
 
+def test_a_shift_read_off_a_mistrim_an_alpha_bias_would_make_is_not_named(tmp_path):
+    """The probe's seed 4332: an A-4 (7,450 ft / 516 ft/s, pitch doublets at 25 Hz, 1.8 times
+    the noise, thrust recorded without its line) with C_m,α −0.13 had a 0.17 ft shift named from
+    C_m's constant −0.0035. The thrust's moment makes −0.0030 of it (the noise-free null's own
+    constant) and the rest is what an α vane 0.08° low makes, a bias the kinematics put at
+    −0.06° ± 0.04° (term_rules.withhold_shift_a_vane_bias_makes): nothing is named."""
+    truth, result = _diagnosed_probe(4332, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "A4" and truth["parameter"] == "Cm_alpha"
+    assert _found(result) == []
+    shift = next(c for c in result["candidates"] if c["parameter"] == "dx_moment_reference")
+    assert "the kinematics cannot rule that bias out" in shift["reason"], shift["reason"]
+
+
 @pytest.mark.parametrize("seed", [4264, 4316])
 def test_a_control_change_an_unoffered_alphadot_term_would_make_is_not_named(tmp_path, seed):
     """The probe's seeds 4264 and 4316: a c182 (pitch doublets) and a J3 Cub (2-1-1) at 1.8 and

@@ -46,7 +46,7 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane,
                                           withhold_resting_on_an_uncertain_correction, withhold_rivals,
-                                          withhold_beside_the_unoffered_alphadot,
+                                          withhold_beside_the_unoffered_alphadot, withhold_shift_a_vane_bias_makes,
                                           withhold_the_shift_remainder)
 from harness.diagnosis.wander_rules import withhold_within_the_unseen_wander
 from models.aircraft import Aircraft, has_propeller
@@ -155,6 +155,8 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
         cands.append(pinned_shift(step.pinned, p, aero.trim))
     withhold_shift_within_thrust(cands, step, p, aero.trim, mismatch, measured)
     withhold_stiffness_a_shift_makes(cands, step, p, mismatch, measured)
+    withhold_shift_a_vane_bias_makes(cands, step, p, kin, set(sensor_values), slope_of, mismatch, measured, aero.trim,
+                                     V0)
     withhold_on_moving_throttle(cands, p, propeller)
     withhold_beside_the_accelerometer(cands, step.selections, p, as_evaluated, noise)
     # the rules that keep a term from being named when something else would imitate it

@@ -21,7 +21,8 @@ from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_pl
 from harness.diagnosis.prepare import Prepared, clean_channels
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYRO_UNIT, GYROS, kinematic_estimate, kinematic_std_error,
                                             kinematic_t, suspected_estimate, unit_members)
-from harness.diagnosis.stepwise_axes import CG_MEAN_Z, StepwiseFits, shift_mistrim_test, vane_error_column
+from harness.diagnosis.stepwise_axes import (CG_MEAN_Z, StepwiseFits, shift_mistrim_test, thrust_mistrim_bound,
+                                            vane_error_column)
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import InitialCondition
@@ -532,6 +533,47 @@ def kinematic_bias_of(kin: KinematicResult, channel: str, applied: set[str]) -> 
         return 0.0, np.inf
     se = kin.selection.std_errors.get(name, np.inf)
     return (0.0 if name in applied else kin.selection.params[name]), (se if se > 0 else np.inf)
+
+
+def withhold_shift_a_vane_bias_makes(cands: list[Candidate], step: StepwiseFits, p: Prepared, kin: KinematicResult,
+                                     applied: set[str], slope_of, mismatch: dict[str, np.ndarray],
+                                     measured: dict[str, np.ndarray], trim, V0: float) -> None:
+    """Deselect a moment-reference shift whose C_m mistrim, less what the thrust's own moment
+    can make (:func:`stepwise_axes.thrust_mistrim_bound`), an α-vane bias would make: the model
+    evaluated along an α reading b high is off by −b times its C_m slope (``slope_of``), so the
+    mistrim's rest R takes b = −R over the slope's mean. Withheld when that b is plausible
+    (:func:`kinematics.is_plausible`) and within :data:`rivals.KINEMATIC_Z` standard errors of
+    the kinematic estimate of the bias (:func:`kinematic_bias_of`): the mean of C_m, which
+    alone tells a shift from a C_m,α change, then says nothing a bias could not. A probe's A-4
+    (7,450 ft / 516 ft/s, pitch doublets at 25 Hz, 1.8 times the noise, thrust recorded without
+    its line) with C_m,α −0.13 had a 0.17 ft shift named from C_m's constant −0.0035: the
+    thrust's moment makes −0.0030 (the noise-free null's constant), and the rest an α reading
+    0.08° low makes, where the kinematics put the bias at −0.06° ± 0.04°."""
+    shifts = [c for c in cands if c.selected and c.parameter == "dx_moment_reference" and c.channel == "Cm"]
+    if not shifts or "Cm" not in step.selections:
+        return
+    inner = interior(p)
+    slope = float(np.mean(slope_of("alpha")["Cm"][inner]))
+    cbar, cz = p.meta["geometry"]["cbar_ft"], float(np.mean(measured["CZ"][inner]))
+    bound = 0.0 if "thrust" in p.raw and "thrust_offset_ft" in p.meta else thrust_mistrim_bound(p, trim)
+    estimate, se = kinematic_bias_of(kin, "alpha", applied)
+    for c in shifts:
+        test = shift_mistrim_test(p, c.estimate, "Cm", step.selections, step.nuisances, mismatch, measured)
+        if test is None or slope == 0.0:
+            continue
+        mistrim = test.dx_ft * cz / cbar
+        rest = np.sign(mistrim) * max(abs(mistrim) - bound, 0.0)
+        bias = -rest / slope
+        if not is_plausible("bias_alpha", bias, V0) or abs(bias - estimate) > rivals.KINEMATIC_Z * se:
+            continue
+        c.selected = False
+        c.details["bias_alternative"] = {"bias_alpha_rad": bias, "kinematic": estimate, "kinematic_std": se,
+                                         "mistrim": mistrim, "thrust_mistrim_bound": bound}
+        c.reason = (f"not named: C_m's mistrim ({mistrim:+.2g}), less the {bound:.2g} the thrust's moment can make, is "
+                    f"what an α vane reading {np.degrees(bias):+.2f}° off makes through the model's C_m slope, and "
+                    f"the kinematics cannot rule that bias out ({np.degrees(estimate):+.2f}° ± "
+                    f"{np.degrees(se):.2f}°): the mean of C_m cannot tell the shift from the C_m,α change its C_Z "
+                    "column imitates")
 
 
 def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],

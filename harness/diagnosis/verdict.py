@@ -304,11 +304,17 @@ def none_finding(a: Analysis, fits_b: dict) -> dict:
             "fit_before": fits_b, "fit_after": fits_b, "explanation": _none_text(a.candidates)}
 
 
+# How the rules that keep a significant candidate from being named for what would imitate it
+# begin its reason (the others: "not entered", "below the entry t", too small to matter).
+WITHHELD_REASONS = ("entered, but", "not named:", "fitted, but not named", "not applied or named")
+
+
 def _none_text(cands: list) -> str:
     """The ``none`` verdict's explanation: noise alone, or, where terms entered the fit but
     were withheld for what would imitate them, that the data could not tell which (the
     strongest of them with its reason), never that noise explains it."""
-    withheld = sorted((c for c in cands if c.reason.startswith("entered, but")), key=lambda c: -abs(c.t))
+    withheld = sorted((c for c in cands if c.reason.startswith(WITHHELD_REASONS) and abs(c.t) >= cand.T_IN),
+                      key=lambda c: -abs(c.t))
     if not withheld:
         return ("No candidate effect is both significant against the noise the data themselves show and large "
                 f"enough to matter (at least {100 * cand.PRACTICAL_SHARE:.0f} % of its coefficient's excursion): "
@@ -316,8 +322,8 @@ def _none_text(cands: list) -> str:
                 "(see not_checked).")
     first = withheld[0]
     why = first.reason.split(":", 1)[-1].strip()
-    return (f"No effect is named: {len(withheld)} candidate{'s' if len(withheld) > 1 else ''} entered the fit "
-            f"but {'were' if len(withheld) > 1 else 'was'} withheld because the data cannot tell "
+    return (f"No effect is named: {len(withheld)} significant candidate{'s' if len(withheld) > 1 else ''} "
+            f"{'were' if len(withheld) > 1 else 'was'} withheld because the data cannot tell "
             f"{'them' if len(withheld) > 1 else 'it'} from something else that would imitate "
             f"{'them' if len(withheld) > 1 else 'it'} (the strongest, {first.parameter} at t = {first.t:.1f}: {why}). "
             "A maneuver that separates the two is needed to say which; see not_checked for what this one "
