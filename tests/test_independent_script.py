@@ -1052,8 +1052,9 @@ def test_a_reference_point_the_stepwise_splits_with_alpha_is_not_named_a_stiffne
     which on a pitch maneuver follows α. The stepwise shared the mismatch between the C_Z
     column (a shift of the wrong sign, refuted by C_m's mean) and α, and the C_m,α change
     (+0.32, the 0.15 ft shift's) was named alone, though C_m's constant carried the mistrim
-    of a 0.24 ft shift of the same sign. The two cannot be told apart: neither is named as
-    the other (stepwise_axes.withhold_stiffness_a_shift_makes)."""
+    of a 0.24 ft shift of the same sign. A C_m,α change about trim makes no mistrim: the
+    change is withheld and the shift the mistrim says is the candidate in its place
+    (stepwise_axes.withhold_stiffness_a_shift_makes)."""
     _with_sweeps(monkeypatch)
     root = _f16_with_reference_moved(tmp_path / "root", -1.9, model="c172x")
     rec = fly(tmp_path / "id.csv", "c172x", 7152.0, 160.0, 3095, 100.0, "sweep_pitch", amplitude_deg=9.0,
@@ -1253,6 +1254,21 @@ def test_a_rate_lag_the_kinematics_give_to_its_attitude_is_no_aileron_delay(tmp_
     assert _found(result) == []
     delay = next(c for c in result["candidates"] if c["parameter"] == "tau_da")
     assert "phi leading p" in delay["reason"], delay["reason"]
+
+
+@pytest.mark.parametrize("seed", [4355, 4369])
+def test_a_shift_whose_stiffness_change_is_withheld_is_named_from_the_mistrim(tmp_path, seed):
+    """The probe's seeds 4355 and 4369: a Cessna 172R (pitch, reference point 0.67 ft forward)
+    and a 787-8 (three-axis, 3.07 ft forward), thrust not recorded. The stepwise entered C_m,α
+    changes for the shifts' C_Z columns (t 32.5, 8.1), withheld because C_m's constant carries
+    the mistrim of a shift of the same sign (−0.74, −3.18 ft), which a C_m,α change about trim
+    does not make, and nothing was named. That shift is now the candidate in the change's place
+    (stepwise_axes.withhold_stiffness_a_shift_makes): it alone is named, within 25 %."""
+    truth, result = _diagnosed_probe(seed, tmp_path, calibrate=False)
+    assert truth["parameter"] == "dx_moment_reference"
+    _named_alone(result, truth, rel=0.25)
+    stiffness = next(c for c in result["candidates"] if c["parameter"] == "Cm_alpha")
+    assert "the shift is the candidate in its place" in stiffness["reason"], stiffness["reason"]
 
 
 def test_a_shift_read_off_a_mistrim_an_alpha_bias_would_make_is_not_named(tmp_path):

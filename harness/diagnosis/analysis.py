@@ -154,7 +154,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     if step.pinned is not None:
         cands.append(pinned_shift(step.pinned, p, aero.trim))
     withhold_shift_within_thrust(cands, step, p, aero.trim, mismatch, measured)
-    withhold_stiffness_a_shift_makes(cands, step, p, mismatch, measured)
+    withhold_stiffness_a_shift_makes(cands, step, p, mismatch, measured, aero.trim)
     withhold_shift_a_vane_bias_makes(cands, step, p, kin, set(sensor_values), slope_of, mismatch, measured, aero.trim,
                                      V0)
     withhold_on_moving_throttle(cands, p, propeller)

@@ -286,7 +286,8 @@ def withhold_shift_within_thrust(cands: list[Candidate], step: StepwiseFits, p: 
 
 
 def withhold_stiffness_a_shift_makes(cands: list[Candidate], step: StepwiseFits, p: Prepared,
-                                     mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> None:
+                                     mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray],
+                                     trim: TrimPoint | None = None) -> None:
     """A C_m,α change is not named when a moment-reference shift reads as it and C_m's mean
     carries the mistrim that shift predicts: the shift Δx whose Δx·C_Z/c̄ is nearest the
     change's own contribution (least squares on the measured C_Z), tested by
@@ -298,7 +299,12 @@ def withhold_stiffness_a_shift_makes(cands: list[Candidate], step: StepwiseFits,
     c172x (7,150 ft / 160 ft/s, pitch sweep, thrust not recorded) with its reference point
     0.16 ft from the model's had the stepwise's shift refuted by its wrong sign (its C_Z column
     shared with the α one), and the C_m,α change of +0.32 (a 0.15 ft shift) named in its place
-    while C_m's constant said 0.24 ft."""
+    while C_m's constant said 0.24 ft. The shift the mistrim says is then the candidate in the
+    change's place (:func:`pinned_shift`, with the model's ``trim`` for the thrust's bound): a
+    probe's 787-8 (26,100 ft / 698 ft/s, three-axis, 1.7 times the noise, thrust not recorded)
+    with its reference point 3.07 ft aft had C_m,α −1.12 entered (t 8.1) for it and withheld,
+    C_m's constant saying −3.18 ± 0.04 ft, and nothing was named; likewise an F-16, an F-4N and
+    a Cessna 172R with shifts of 0.16-0.67 ft (pitch maneuvers)."""
     _, by_key = step.selections.get("Cm", (None, {}))
     inner = interior(p)
     cbar = p.meta["geometry"]["cbar_ft"]
@@ -323,8 +329,12 @@ def withhold_stiffness_a_shift_makes(cands: list[Candidate], step: StepwiseFits,
                                           "mistrim_std_error_ft": test.std_error_ft}
         c.reason = (f"not named: a moment-reference shift of {dx:.3g} ft reads as this change on a maneuver whose C_Z "
                     f"follows α, and C_m's constant carries the mistrim of a {test.dx_ft:.3g} ± "
-                    f"{test.std_error_ft:.2g} ft shift, which a C_m,α change about trim does not make; the recording "
-                    f"cannot tell the two apart (it had been: {c.reason})")
+                    f"{test.std_error_ft:.2g} ft shift, which a C_m,α change about trim does not make: the shift is "
+                    f"the candidate in its place (it had been: {c.reason})")
+        if not any(o.selected and o.parameter == "dx_moment_reference" for o in cands):
+            shift = pinned_shift(test, p, trim)
+            shift.details["in_place_of"] = {"parameter": c.parameter, "change": change, "dx_ft": dx}
+            cands.append(shift)
 
 
 # How far (a factor either way) the shift C_m's mistrim says may lie from the one a C_m,α
