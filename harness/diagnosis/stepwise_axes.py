@@ -421,6 +421,19 @@ def _cg_mean_test(p: Prepared, axis: str, selections: dict, nuisances: dict,
     return test
 
 
+def constant_beside_terms(p: Prepared, axis: str, selections: dict, nuisances: dict,
+                          mismatch: dict[str, np.ndarray]) -> tuple[float, float]:
+    """The constant of ``axis``'s mismatch over the interior beside the axis's entered terms
+    (a moment-reference shift's excepted) and nuisance columns, and its standard error (a
+    colored-residual fit, Eq. 5's standard errors)."""
+    inner = interior(p)
+    sel, terms = selections[axis]
+    cols = [terms[k].column[inner] for k in sel.names if k in terms and k != "cg"]
+    cols += [c[inner] for c in nuisances.get(axis, {}).values() if np.ptp(c[inner]) > 0]
+    theta, se, _ = colored_fit(mismatch[axis][inner], cols, [f"x{i}" for i in range(len(cols))])
+    return float(theta[-1]), float(se[-1])
+
+
 def shift_mistrim_test(p: Prepared, dx: float, axis: str, selections: dict, nuisances: dict,
                        mismatch: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> CgMeanTest | None:
     """A moment-reference shift of ``dx`` ft, read off ``axis``'s mismatch, against the mean
@@ -433,11 +446,7 @@ def shift_mistrim_test(p: Prepared, dx: float, axis: str, selections: dict, nuis
     if cz == 0.0:
         return None  # no lift on average (a zero-g arc): the mean says nothing of a shift
     predicted = dx * cz / cbar
-    cm_sel, cm_terms = selections["Cm"]
-    cols = [cm_terms[k].column[inner] for k in cm_sel.names if k in cm_terms and k != "cg"]
-    cols += [c[inner] for c in nuisances.get("Cm", {}).values() if np.ptp(c[inner]) > 0]
-    theta, se, _ = colored_fit(mismatch["Cm"][inner], cols, [f"x{i}" for i in range(len(cols))])
-    mean, mean_se = float(theta[-1]), float(se[-1])
+    mean, mean_se = constant_beside_terms(p, "Cm", selections, nuisances, mismatch)
     # only a mistrim short of the prediction refutes: one beyond it (a larger shift, which the
     # other entered terms shared out) supports the shift
     short = abs(predicted) - mean * np.sign(predicted)

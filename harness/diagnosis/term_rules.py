@@ -21,8 +21,8 @@ from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_pl
 from harness.diagnosis.prepare import Prepared, clean_channels
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYRO_UNIT, GYROS, kinematic_estimate, kinematic_std_error,
                                             kinematic_t, suspected_estimate, unit_members)
-from harness.diagnosis.stepwise_axes import (CG_MEAN_Z, StepwiseFits, shift_mistrim_test, thrust_mistrim_bound,
-                                            vane_error_column)
+from harness.diagnosis.stepwise_axes import (CG_MEAN_Z, StepwiseFits, constant_beside_terms, shift_mistrim_test,
+                                            thrust_mistrim_bound, vane_error_column)
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import InitialCondition
@@ -542,13 +542,18 @@ def withhold_shift_a_vane_bias_makes(cands: list[Candidate], step: StepwiseFits,
     can make (:func:`stepwise_axes.thrust_mistrim_bound`), an α-vane bias would make: the model
     evaluated along an α reading b high is off by −b times its C_m slope (``slope_of``), so the
     mistrim's rest R takes b = −R over the slope's mean. Withheld when that b is plausible
-    (:func:`kinematics.is_plausible`) and within :data:`rivals.KINEMATIC_Z` standard errors of
-    the kinematic estimate of the bias (:func:`kinematic_bias_of`): the mean of C_m, which
-    alone tells a shift from a C_m,α change, then says nothing a bias could not. A probe's A-4
-    (7,450 ft / 516 ft/s, pitch doublets at 25 Hz, 1.8 times the noise, thrust recorded without
-    its line) with C_m,α −0.13 had a 0.17 ft shift named from C_m's constant −0.0035: the
-    thrust's moment makes −0.0030 (the noise-free null's constant), and the rest an α reading
-    0.08° low makes, where the kinematics put the bias at −0.06° ± 0.04°."""
+    (:func:`kinematics.is_plausible`), within :data:`rivals.KINEMATIC_Z` standard errors of
+    the kinematic estimate of the bias (:func:`kinematic_bias_of`) and of what C_Z's constant
+    says of it (the bias puts −b times C_Z's slope there, a shift nothing): the mean of C_m,
+    which alone tells a shift from a C_m,α change, then says nothing a bias could not. A
+    probe's A-4 (7,450 ft / 516 ft/s, pitch doublets at 25 Hz, 1.8 times the noise, thrust
+    recorded without its line) with C_m,α −0.13 had a 0.17 ft shift named from C_m's constant
+    −0.0035: the thrust's moment makes −0.0030 (the noise-free null's constant), and the rest
+    an α reading 0.07° low makes, where the kinematics put the bias at −0.06° ± 0.04° and C_Z's
+    constant, −0.0028 ± 0.0011, is the −0.005 it would make within two standard errors. On a
+    c172x, whose C_m slope is steep, the mistrim of a 0.31 ft shift is an α bias of −0.80°, and
+    the kinematics without h allow it (+0.14° ± 0.62°), but C_Z's constant, −0.0015 ± 0.0022,
+    is not the −0.063 it would make."""
     shifts = [c for c in cands if c.selected and c.parameter == "dx_moment_reference" and c.channel == "Cm"]
     if not shifts or "Cm" not in step.selections:
         return
@@ -566,14 +571,19 @@ def withhold_shift_a_vane_bias_makes(cands: list[Candidate], step: StepwiseFits,
         bias = -rest / slope
         if not is_plausible("bias_alpha", bias, V0) or abs(bias - estimate) > rivals.KINEMATIC_Z * se:
             continue
+        lift, lift_se = constant_beside_terms(p, "CZ", step.selections, step.nuisances, mismatch)
+        lift_made = -float(np.mean(slope_of("alpha")["CZ"][inner])) * bias
+        if abs(lift - lift_made) > rivals.KINEMATIC_Z * lift_se:
+            continue
         c.selected = False
         c.details["bias_alternative"] = {"bias_alpha_rad": bias, "kinematic": estimate, "kinematic_std": se,
-                                         "mistrim": mistrim, "thrust_mistrim_bound": bound}
+                                         "mistrim": mistrim, "thrust_mistrim_bound": bound,
+                                         "cz_constant": lift, "cz_constant_std": lift_se, "cz_constant_made": lift_made}
         c.reason = (f"not named: C_m's mistrim ({mistrim:+.2g}), less the {bound:.2g} the thrust's moment can make, is "
                     f"what an α vane reading {np.degrees(bias):+.2f}° off makes through the model's C_m slope, and "
-                    f"the kinematics cannot rule that bias out ({np.degrees(estimate):+.2f}° ± "
-                    f"{np.degrees(se):.2f}°): the mean of C_m cannot tell the shift from the C_m,α change its C_Z "
-                    "column imitates")
+                    f"neither the kinematics ({np.degrees(estimate):+.2f}° ± {np.degrees(se):.2f}°) nor C_Z's constant "
+                    f"({lift:+.2g} ± {lift_se:.1g}, the bias would make {lift_made:+.2g}) rule that bias out: the mean of "
+                    "C_m cannot tell the shift from the C_m,α change its C_Z column imitates")
 
 
 def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
