@@ -1271,6 +1271,19 @@ def test_a_shift_whose_stiffness_change_is_withheld_is_named_from_the_mistrim(tm
     assert "the shift is the candidate in its place" in stiffness["reason"], stiffness["reason"]
 
 
+def test_skews_a_linearised_alpha_skew_leaves_are_not_named(tmp_path):
+    """The probe's seed 4410: a noise-free F-4N (25,000 ft / 655 ft/s, three-axis 2-1-1s at
+    100 Hz, metric units) with α 69 ms late had the skew named (66 ms, t 125) and beside it a_x
+    and a_z skews of 66 and 71 ms (t 27, 19): the first-order skew column's leftover, τ²ẍ/2,
+    which reaches the equations α shares with the accelerometers. With α shifted exactly they
+    stand at t 0.2 and 0.1 (sensor_naming.withhold_left_by_a_linearised_skew): the α skew alone."""
+    truth, result = _diagnosed_probe(4410, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "F4N" and truth["noise_factor"] == 0.0
+    _named_alone(result, truth, rel=0.1)
+    ax = next(c for c in result["candidates"] if c["parameter"] == "skew_ax")
+    assert "first-order column's leftover" in ax["reason"], ax["reason"]
+
+
 def test_a_shift_read_off_a_mistrim_an_alpha_bias_would_make_is_not_named(tmp_path):
     """The probe's seed 4332: an A-4 (7,450 ft / 516 ft/s, pitch doublets at 25 Hz, 1.8 times
     the noise, thrust recorded without its line) with C_m,α −0.13 had a 0.17 ft shift named from

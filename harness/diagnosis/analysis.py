@@ -24,6 +24,7 @@ from harness.diagnosis.prepare import COEFFICIENTS, Prepared
 from harness.diagnosis.sensor_naming import (VANE_MEANS_AXES, kinematic_rivals, name_applied, name_corroborated,
                                              name_vane_bias_from_means, signature_ratios,
                                              withhold_delays_imitated_by_named, withhold_imitated_by_named,
+                                             withhold_left_by_a_linearised_skew,
                                              withhold_scale_left_by_a_linearised_skew, withhold_vane_scale)
 from harness.diagnosis.sensor_rules import (applied_sensor_values, biases_of_contested, contested_parameters,
                                             kinematic_candidates, kinematics_plausible, name_accelerometer_once,
@@ -205,6 +206,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
             scale_read_as_bias(cands, recorded)
             withhold_scale_a_bias_would_make(cands, kin, recorded)
             withhold_scale_left_by_a_linearised_skew(cands, kin, recorded)
+            withhold_left_by_a_linearised_skew(cands, kin, recorded)
             withhold_offset_of_a_scaled_vane(cands, kin, p, aircraft, ic, as_evaluated, noise, sensor_values)
             withhold_imitated_by_named(cands, imitated, set(sensor_values))
             withhold_delays_imitated_by_named(cands, kin, p, aircraft, ic, aero.derivatives, noise, set(sensor_values))

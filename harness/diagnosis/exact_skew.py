@@ -122,9 +122,8 @@ def _best_exact(rss, start: float, margin: float, full: bool = False):
 
 def scale_beside_exact_skew(kin: KinematicResult, p: Prepared, scale: str) -> float | None:
     """|t| of scale factor ``scale`` in the kinematic fit with its channel shifted exactly by
-    the time skew the fit takes on it (the shift's best τ, :func:`fractional_shift`, with the
-    skew's and the scale's columns and the other selected terms fitted beside it); None when
-    the fit takes no skew on that channel.
+    the time skew the fit takes on it (:func:`term_beside_exact_skew`); None when the fit
+    takes no skew on that channel.
 
     The first-order skew column leaves τ²ẍ/2 out (module docstring); on a channel moving at
     one frequency ω that is −τ²ω²/2 of the channel itself, which the linearised fit gives to
@@ -132,20 +131,28 @@ def scale_beside_exact_skew(kin: KinematicResult, p: Prepared, scale: str) -> fl
     aileron and rudder, 200 Hz) with r 71 ms late had the skew named (t 22) and beside it a
     scale of +0.054 on r (kinematic t 5.1), corroborated by C_n, which the same linearised
     correction reached."""
+    return term_beside_exact_skew(kin, p, scale, f"skew_{kin.parameters[scale].channel}")
+
+
+def term_beside_exact_skew(kin: KinematicResult, p: Prepared, term: str, skew: str) -> float | None:
+    """|t| of selected kinematic term ``term`` with the channel of selected time skew ``skew``
+    shifted exactly (the shift's best τ, :func:`fractional_shift`, with the skew's and the
+    term's columns and the other selected terms fitted beside it); None when either is not
+    in the fit. What the term fitted of the first-order skew column's leftover, τ²ẍ/2, is gone
+    then; what it fits of its own error stays."""
     cols = kin.columns or {}
-    channel = kin.parameters[scale].channel
-    skew = f"skew_{channel}"
-    if scale not in cols or skew not in cols or skew not in kin.selection.names:
+    if term not in cols or skew not in cols or skew not in kin.selection.names:
         return None
-    others = [n for n in kin.forced + kin.selection.names if n not in (scale, skew) and n in cols]
-    fixed = [cols[n] for n in others] + [cols[scale]]
+    channel = kin.parameters[skew].channel
+    others = [n for n in kin.forced + kin.selection.names if n not in (term, skew) and n in cols]
+    fixed = [cols[n] for n in others] + [cols[term]]
     raw = dict(p.raw)
 
     def shifted(tau: float) -> np.ndarray:
         return stacked_residual(raw | {channel: fractional_shift(raw[channel], tau, p.dt)}, p, kin)
     tau = _best_exact(lambda x: _rss(shifted(x), fixed), kin.selection.params[skew], 2.0 * p.dt, full=True).x
     try:
-        theta, se, _ = colored_fit(shifted(float(tau)), fixed + [cols[skew]], others + [scale, skew], constant=False)
+        theta, se, _ = colored_fit(shifted(float(tau)), fixed + [cols[skew]], others + [term, skew], constant=False)
     except (SingularRegressorsError, np.linalg.LinAlgError):
         return None
     return abs(float(theta[-2]) / float(se[-2])) if se[-2] > 0 else 0.0

@@ -11,7 +11,7 @@ from harness.diagnosis import corroborate
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along
 from harness.diagnosis.evidence import Candidate
-from harness.diagnosis.exact_skew import scale_beside_exact_skew
+from harness.diagnosis.exact_skew import scale_beside_exact_skew, term_beside_exact_skew
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
@@ -319,6 +319,34 @@ def withhold_scale_left_by_a_linearised_skew(cands: list[Candidate], kin: Kinema
                     f"at t = {t:.1f}; what it fitted is the first-order skew column's leftover (τ²ẍ/2, a scale of "
                     f"{channel} at one frequency), which the coefficient mismatch, corrected by the same column, "
                     f"shows too (it had been: {c.reason})")
+
+
+def withhold_left_by_a_linearised_skew(cands: list[Candidate], kin: KinematicResult, recorded: Prepared) -> None:
+    """Deselect a named kinematic sensor term that falls below :data:`AMBIGUOUS_T` with the
+    channel of a stronger named time skew (a larger kinematic t) shifted exactly
+    (:func:`exact_skew.term_beside_exact_skew`, on the ``recorded`` channels): it fitted the
+    first-order skew column's leftover, τ²ẍ/2, which reaches every equation the skewed channel
+    is in. (A scale of the skewed channel itself: :func:`withhold_scale_left_by_a_linearised_skew`.)
+    A probe's noise-free F-4N (25,000 ft / 655 ft/s, three-axis 2-1-1s at 100 Hz) with α 69 ms
+    late had the skew named (66 ms, t 125) and beside it a_x and a_z skews of 66 and 71 ms
+    (t 27, 19), confirmed on the validation maneuver by the same leftover; with α shifted by
+    exactly 69 ms nothing is found."""
+    skews = sorted((c for c in cands if c.selected and c.effect == "sensor_time_skew" and c.parameter in kin.parameters),
+                   key=lambda c: -abs(c.t))
+    for strong in skews:
+        if not strong.selected:
+            continue
+        for c in cands:
+            if not (c.selected and c is not strong and c.test == "kinematic consistency" and abs(c.t) < abs(strong.t)):
+                continue
+            t = term_beside_exact_skew(kin, recorded, c.parameter, strong.parameter)
+            if t is None or t >= AMBIGUOUS_T:
+                continue
+            c.selected = False
+            c.details["beside_exact_skew_t"] = t
+            c.reason = (f"not named: with {kin.parameters[strong.parameter].channel} shifted exactly by the "
+                        f"{strong.parameter} named it stands at t = {t:.1f}; what it fitted is that skew's first-order "
+                        f"column's leftover (τ²ẍ/2), not an error of its own (it had been: {c.reason})")
 
 
 def withhold_corroborated_rivals(named: list[Candidate], kin: KinematicResult) -> None:

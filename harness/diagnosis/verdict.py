@@ -305,15 +305,20 @@ def none_finding(a: Analysis, fits_b: dict) -> dict:
 
 
 # How the rules that keep a significant candidate from being named for what would imitate it
-# begin its reason (the others: "not entered", "below the entry t", too small to matter).
+# begin its reason (the others: "not entered", "below the entry t", too small to matter) ...
 WITHHELD_REASONS = ("entered, but", "not named:", "fitted, but not named", "not applied or named")
+# ... less the entered terms kept out for their size or their significance
+# (stepwise_axes._impractical_reason, not_entered_reason, the delay scan's bounds).
+NOT_WITHHELD_REASONS = ("entered, but too small to matter", "entered, but under", "entered, but the delay lies beyond",
+                        "entered, but with the residual")
 
 
 def _none_text(cands: list) -> str:
     """The ``none`` verdict's explanation: noise alone, or, where terms entered the fit but
     were withheld for what would imitate them, that the data could not tell which (the
     strongest of them with its reason), never that noise explains it."""
-    withheld = sorted((c for c in cands if c.reason.startswith(WITHHELD_REASONS) and abs(c.t) >= cand.T_IN),
+    withheld = sorted((c for c in cands if c.reason.startswith(WITHHELD_REASONS) and abs(c.t) >= cand.T_IN
+                       and not c.reason.startswith(NOT_WITHHELD_REASONS)),
                       key=lambda c: -abs(c.t))
     if not withheld:
         return ("No candidate effect is both significant against the noise the data themselves show and large "
