@@ -1204,7 +1204,7 @@ def test_a_slow_aircraft_s_airspeed_bias_is_named_and_the_model_trimmed_where_it
     5 % of V; at least 10 kt is allowed now, kinematics.AIRSPEED_ERROR_FLOOR_FPS) and an α scale
     of −0.041, then a C_m,δe 2.3 % weaker than the model, were named: the model had been trimmed
     at the recorded airspeed, its propeller's thrust and slipstream those of a faster flight.
-    Trimmed at the corrected airspeed (analysis.corrected_start) the bias alone is named."""
+    Trimmed at the corrected airspeed (along.corrected_start) the bias alone is named."""
     truth, result = _diagnosed_probe(3998, tmp_path, calibrate_workers=1)
     assert truth["aircraft"] == "J3Cub" and truth["parameter"] == "bias_V" and truth["noise_factor"] == 0.0
     _named_alone(result, truth, rel=0.25)
@@ -1269,6 +1269,42 @@ def test_a_shift_whose_stiffness_change_is_withheld_is_named_from_the_mistrim(tm
     _named_alone(result, truth, rel=0.25)
     stiffness = next(c for c in result["candidates"] if c["parameter"] == "Cm_alpha")
     assert "the shift is the candidate in its place" in stiffness["reason"], stiffness["reason"]
+
+
+def test_an_airspeed_correction_takes_the_stand_in_altitude_with_it(tmp_path):
+    """The probe's seed 4453: a J-3 Cub (3,350 ft / 97 ft/s, lateral multisine at 100 Hz, no
+    h channel) with V 8.0 ft/s low. The altitude stood in from q̄ and V was −2,780 ft, and with
+    the airspeed corrected it stayed there: the model flown at that density, its propeller's
+    power with it, had C_l,β, C_l,r̂, C_n,p̂ and C_n,δr named. The altitude is taken again from
+    the corrected channels (along.corrected_recording): nothing is named."""
+    truth, result = _diagnosed_probe(4453, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "J3Cub" and truth["parameter"] == "bias_V"
+    assert [p for p, _ in _found(result)] in ([], ["bias_V"])
+
+
+def test_a_corrected_airspeed_stands_in_the_altitude_again(monkeypatch):
+    """along.corrected_recording: without an h channel the stand-in altitude is the ISA
+    altitude of 2 q̄ / V² from the corrected channels (prepare.stand_in_altitude), higher for
+    an airspeed corrected upward; with V and q̄ untouched it stays."""
+    from types import SimpleNamespace
+    import harness.diagnosis.along as along
+    from harness.diagnosis.prepare import stand_in_altitude
+    from harness.isa import density_altitude_ft
+    n = 50
+    raw = {"V": np.full(n, 300.0), "qbar": np.full(n, 0.5 * 0.0020482 * 300.0 ** 2), "p": np.zeros(n)}
+    noise = {c: np.zeros(n) for c in raw}
+    assert stand_in_altitude(raw, noise) == pytest.approx(density_altitude_ft(np.full(n, 0.0020482)))
+    p = SimpleNamespace(raw=raw, own_noise=noise, altitude=stand_in_altitude(raw, noise), dt=0.02,
+                        filt=lambda x: x, differentiate=lambda x: np.zeros_like(x))
+    kin = SimpleNamespace(parameters={})
+    monkeypatch.setattr(along, "replace", lambda q, **kw: SimpleNamespace(**{**vars(q), **kw}))
+    faster = dict(raw, V=raw["V"] * 1.1)
+    monkeypatch.setattr(along, "corrected_channels", lambda *_: faster)
+    out = along.corrected_recording(p, kin, {"bias_V": -30.0})
+    np.testing.assert_allclose(out.altitude, density_altitude_ft(2.0 * raw["qbar"] / faster["V"] ** 2))
+    assert np.all(out.altitude > p.altitude)  # thinner air at the higher airspeed
+    monkeypatch.setattr(along, "corrected_channels", lambda *_: dict(raw, p=raw["p"] + 0.01))
+    assert along.corrected_recording(p, kin, {"bias_p": -0.01}).altitude is p.altitude
 
 
 def test_skews_a_linearised_alpha_skew_leaves_are_not_named(tmp_path):

@@ -14,15 +14,19 @@ from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles, kinematic_alpha_rate
 from harness.diagnosis.prepare import (COEFFICIENTS, DRIVEN_BY, Prepared, clean_channels, interior_slice,
-                                       measured_coefficients)
+                                       measured_coefficients, stand_in_altitude)
 from models.aircraft import Aircraft
 from models.constants import SURFACES
-from models.replay import AeroAlong, InitialCondition, aero_along
+from models.replay import AeroAlong, InitialCondition, aero_along, initial_condition
 
 
 def corrected_recording(p: Prepared, kin: KinematicResult, values: dict[str, float]) -> Prepared:
     """The recording with its channels corrected for the sensor ``values`` (re-smoothed and
-    re-differentiated); ``p`` itself when there are none."""
+    re-differentiated); ``p`` itself when there are none. Without an ``h`` channel the
+    altitude stood in from q̄ and V (:func:`prepare.stand_in_altitude`) is taken again from
+    the corrected ones: a probe's J-3 Cub (3,350 ft / 97 ft/s, lateral multisine, no h) with V
+    8.0 ft/s low stood in −2,780 ft for it, and the model flown there, its propeller's power
+    with it, had four lateral derivatives named (probe seed 4453)."""
     if not values:
         return p
     ch = corrected_channels(p.raw, p, kin.parameters, values)
@@ -30,7 +34,10 @@ def corrected_recording(p: Prepared, kin: KinematicResult, values: dict[str, flo
     deriv = {c: p.differentiate(x) for c, x in ch.items()}
     k = max(1, int(round(0.5 / p.dt)))
     start = {c: float(np.mean(x[:k])) for c, x in smooth.items()}
-    return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start)
+    altitude = p.altitude
+    if "h" not in ch and any(ch[c] is not p.raw.get(c) for c in ("V", "qbar") if c in ch):
+        altitude = stand_in_altitude(ch, p.own_noise)
+    return replace(p, raw=ch, smooth=smooth, deriv=deriv, start=start, altitude=altitude)
 
 
 def rate_derivatives_advanced(p: Prepared, tau: float) -> Prepared:
@@ -199,3 +206,16 @@ def thrust_stand_in(p: Prepared, model_trim_thrust_lbf: float) -> float:
     (recording-format.md), the metadata's trim thrust when given, else the model's."""
     given = (p.meta.get("trim") or {}).get("thrust_lbf")
     return float(given) if given is not None else float(model_trim_thrust_lbf)
+
+
+def corrected_start(p: Prepared, values: dict[str, float], ic: InitialCondition) -> InitialCondition:
+    """The initial condition of the corrected recording ``p`` when a correction in ``values``
+    changed its airspeed or angle of attack, else ``ic``. The model is trimmed there (its
+    thrust, and with it a propeller's slipstream over the tail), so it must start where the
+    aircraft was, not where its instruments said it was: a probe's J-3 Cub (103 ft/s, pitch
+    doublet, noise-free) with V 8.8 ft/s high, trimmed at the recorded airspeed with the bias
+    named and taken out of the channels, had C_m,δe named 2.3 % weaker than the model (t 23),
+    the slipstream of the faster trim's thrust (probe seed 3998)."""
+    if not any(n.split("_", 1)[-1] in ("V", "alpha") for n in values):
+        return ic
+    return initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude, phi=p.smooth.get("phi"))

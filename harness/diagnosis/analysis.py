@@ -9,7 +9,8 @@ from harness.diagnosis.accelerometer_rules import (note_refuted_positions, refut
                                                    withhold_through_the_inertial_angles,
                                                    withhold_vane_an_accelerometer_makes)
 from harness.diagnosis.airspeed_rules import withhold_on_the_airspeed
-from harness.diagnosis.along import ModelAlong, corrected_recording, inertial_beta, model_along, slope_function
+from harness.diagnosis.along import (ModelAlong, corrected_recording, corrected_start, inertial_beta, model_along,
+                                     slope_function)
 from harness.diagnosis.delay_rules import name_the_delay_the_terms_imitate
 from harness.diagnosis.drift_rules import withhold_lateral_drift_a_slow_sideslip_makes
 from harness.diagnosis.evidence import Analysis
@@ -51,7 +52,7 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_the_shift_remainder)
 from harness.diagnosis.wander_rules import withhold_within_the_unseen_wander
 from models.aircraft import Aircraft, has_propeller
-from models.replay import InitialCondition, initial_condition
+from models.replay import InitialCondition
 
 
 def coefficient_noise(p: Prepared, mismatch: dict[str, np.ndarray]) -> dict[str, float]:
@@ -87,19 +88,6 @@ def _along_corrected(recorded: Prepared, kin: KinematicResult, values: dict[str,
         along = model_along(p, aircraft, start)
         mismatch = along.mismatch()
     return p, along, mismatch, refuted, start
-
-
-def corrected_start(p: Prepared, values: dict[str, float], ic: InitialCondition) -> InitialCondition:
-    """The initial condition of the corrected recording ``p`` when a correction in ``values``
-    changed its airspeed or angle of attack, else ``ic``. The model is trimmed there (its
-    thrust, and with it a propeller's slipstream over the tail), so it must start where the
-    aircraft was, not where its instruments said it was: a probe's J-3 Cub (103 ft/s, pitch
-    doublet, noise-free) with V 8.8 ft/s high, trimmed at the recorded airspeed with the bias
-    named and taken out of the channels, had C_m,δe named 2.3 % weaker than the model (t 23),
-    the slipstream of the faster trim's thrust (probe seed 3998)."""
-    if not any(n.split("_", 1)[-1] in ("V", "alpha") for n in values):
-        return ic
-    return initial_condition(p.t, p.smooth["V"], p.smooth["alpha"], p.altitude, phi=p.smooth.get("phi"))
 
 
 def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:

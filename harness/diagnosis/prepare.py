@@ -328,11 +328,7 @@ def prepare(rec: Recording, name: str = "identification") -> Prepared:
     if "h" in raw:
         altitude = raw["h"] - own_noise["h"]
     else:
-        # pressure altitude from the density that q̄ and V (each by its own optimal smoothing)
-        # imply, ISA standard day; kept out of ``raw``: the kinematic checks must not see a
-        # made-up ḣ
-        rho = 2.0 * (raw["qbar"] - own_noise["qbar"]) / (raw["V"] - own_noise["V"]) ** 2
-        altitude = density_altitude_ft(np.clip(rho, 1e-6, None))
+        altitude = stand_in_altitude(raw, own_noise)
         assumptions.append({"item": "altitude", "missing": "h channel",
                             "stood_in_by": f"the ISA altitude of the density 2 q̄ / V² ({np.mean(altitude[:k]):.0f} ft "
                                            "at the start; a standard day assumed)"})
@@ -574,6 +570,15 @@ def measured_coefficients(s: dict[str, np.ndarray], d: dict[str, np.ndarray], me
 
 _SOURCE_WORDS = {"alpha": "α", "beta": "β", "p": "the roll rate", "q": "the pitch rate", "r": "the yaw rate",
                  "V": "the airspeed", "de": "the stabilator", "da": "the aileron", "dr": "the rudder"}
+
+
+def stand_in_altitude(raw: dict[str, np.ndarray], own_noise: dict[str, np.ndarray]) -> np.ndarray:
+    """The altitude (ft) a recording without an ``h`` channel stands in: the ISA pressure
+    altitude of the density 2 q̄ / V² that q̄ and V (each by its own optimal smoothing, the
+    channel less ``own_noise``) imply, standard day. Kept out of ``raw``: the kinematic checks
+    must not see a made-up ḣ."""
+    rho = 2.0 * (raw["qbar"] - own_noise["qbar"]) / (raw["V"] - own_noise["V"]) ** 2
+    return density_altitude_ft(np.clip(rho, 1e-6, None))
 
 
 def undriven_reason(p: Prepared, sources: list[str] | tuple[str, ...]) -> str:
