@@ -444,7 +444,10 @@ def test_an_alpha_scale_at_the_flap_switch_is_named_alone(tmp_path):
     assert row["error"] is None and row["a"] and row["b"] and row["c"] == 0, (row["first"], row["false"])
     f = json.loads((tmp_path / "diagnoses" / c.name / "findings.json").read_text())
     bias = next(x for x in f["candidates"] if x["parameter"] == "bias_alpha")
-    assert bias["reason"].startswith("read as the offset of scale_alpha")
+    # read as the scale's offset; or, since a corrected airspeed takes the stand-in altitude with
+    # it (fortieth session), not significant along the corrected channels at all
+    assert not bias.get("selected") and bias["reason"].startswith(("read as the offset of scale_alpha",
+                                                                   "below the entry t")), bias["reason"]
 
 
 def test_a_cn_beta_change_on_a_lateral_maneuver_is_not_taken_for_a_moment_reference_shift(tmp_path, monkeypatch):

@@ -7,7 +7,7 @@ import numpy as np
 from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.along import corrected_recording, corrected_start, interior, model_along
+from harness.diagnosis.along import corrected_recording, interior, model_along
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import AIRSPEED_ERROR_FLOOR_FPS, PLAUSIBLE, KinematicResult
 from harness.diagnosis.prepare import Prepared
@@ -42,15 +42,11 @@ def airspeed_signature(p: Prepared, kin: KinematicResult, aircraft: Aircraft, ic
                        mismatch: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], float]:
     """What an airspeed bias puts in each coefficient's mismatch, per ft/s: the channels
     corrected by a bias of :data:`SIGNATURE_SHARE` of the airspeed, the model evaluated again
-    (the rates normalised by the other V, the kinematic α̇, q̄ where it is built from V) and
-    trimmed at the corrected airspeed (:func:`along.corrected_start`: its thrust, and a
-    propeller's slipstream and torque with it), the difference divided by it. Returns the
-    columns and the airspeed (ft/s)."""
+    (the rates normalised by the other V, the kinematic α̇, q̄ where it is built from V), the
+    difference divided by it. Returns the columns and the airspeed (ft/s)."""
     V0 = float(np.mean(p.smooth["V"]))
     dv = SIGNATURE_SHARE * V0
-    corrected = corrected_recording(p, kin, {AIRSPEED_BIAS: dv})
-    start = corrected_start(corrected, {AIRSPEED_BIAS: dv}, ic)
-    changed = model_along(corrected, aircraft, start, inertial_from=p).mismatch()
+    changed = model_along(corrected_recording(p, kin, {AIRSPEED_BIAS: dv}), aircraft, ic, inertial_from=p).mismatch()
     return {c: (changed[c] - mismatch[c]) / dv for c in mismatch}, V0
 
 

@@ -331,7 +331,8 @@ def withhold_left_by_a_linearised_skew(cands: list[Candidate], kin: KinematicRes
     late had the skew named (66 ms, t 125) and beside it a_x and a_z skews of 66 and 71 ms
     (t 27, 19), confirmed on the validation maneuver by the same leftover; with α shifted by
     exactly 69 ms nothing is found."""
-    skews = sorted((c for c in cands if c.selected and c.effect == "sensor_time_skew" and c.parameter in kin.parameters),
+    skews = sorted((c for c in cands
+                    if c.selected and c.effect == "sensor_time_skew" and c.parameter in kin.parameters),
                    key=lambda c: -abs(c.t))
     for strong in skews:
         if not strong.selected:

@@ -26,6 +26,7 @@ from harness.diagnosis.stepwise_axes import (CG_MEAN_Z, StepwiseFits, constant_b
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import InitialCondition
+from models.trim import TrimPoint
 
 
 def _refit_term(z: np.ndarray, others: list[np.ndarray], column: np.ndarray) -> tuple[float, float] | None:
@@ -537,7 +538,7 @@ def kinematic_bias_of(kin: KinematicResult, channel: str, applied: set[str]) -> 
 
 def withhold_shift_a_vane_bias_makes(cands: list[Candidate], step: StepwiseFits, p: Prepared, kin: KinematicResult,
                                      applied: set[str], slope_of, mismatch: dict[str, np.ndarray],
-                                     measured: dict[str, np.ndarray], trim, V0: float) -> None:
+                                     measured: dict[str, np.ndarray], trim: TrimPoint, V0: float) -> None:
     """Deselect a moment-reference shift whose C_m mistrim, less what the thrust's own moment
     can make (:func:`stepwise_axes.thrust_mistrim_bound`), an α-vane bias would make: the model
     evaluated along an α reading b high is off by −b times its C_m slope (``slope_of``), so the
@@ -581,9 +582,9 @@ def withhold_shift_a_vane_bias_makes(cands: list[Candidate], step: StepwiseFits,
                                          "cz_constant": lift, "cz_constant_std": lift_se, "cz_constant_made": lift_made}
         c.reason = (f"not named: C_m's mistrim ({mistrim:+.2g}), less the {bound:.2g} the thrust's moment can make, is "
                     f"what an α vane reading {np.degrees(bias):+.2f}° off makes through the model's C_m slope, and "
-                    f"neither the kinematics ({np.degrees(estimate):+.2f}° ± {np.degrees(se):.2f}°) nor C_Z's constant "
-                    f"({lift:+.2g} ± {lift_se:.1g}, the bias would make {lift_made:+.2g}) rule that bias out: the mean of "
-                    "C_m cannot tell the shift from the C_m,α change its C_Z column imitates")
+                    f"neither the kinematics ({np.degrees(estimate):+.2f}° ± {np.degrees(se):.2f}°) nor C_Z's "
+                    f"constant ({lift:+.2g} ± {lift_se:.1g}, the bias would make {lift_made:+.2g}) rule that bias "
+                    "out: the mean of C_m cannot tell the shift from the C_m,α change its C_Z column imitates")
 
 
 def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, mismatch: dict[str, np.ndarray],
@@ -676,11 +677,11 @@ def withhold_beside_the_unoffered_alphadot(cands: list[Candidate], step: Stepwis
     at least :data:`rivals.TERM_RIVAL_CORRELATION` and the term under the entry t
     (:data:`candidates.T_IN`) beside it. The α̇ column is the kinematic one, from the gyros and
     accelerometers, so it follows a short pulse's response even where the vane's α stays
-    within its noise; it could not be named there, but neither can what it imitates. An
-    independent script's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with
+    within its noise; it could not be named there, but neither can what it imitates. A
+    probe's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with
     C_m,α̇ −11.7 had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the α̇ column
-    (r −0.92) its t fell to 0.9, α̇'s stood at −13.6. A J3 Cub (2-1-1, twice the noise) with
-    C_m,α̇ −8.2 had C_m,δe −0.79 named the same way (beside α̇, t 0.1)."""
+    (r −0.92) its t fell to 0.9, α̇'s stood at −13.6. A J-3 Cub (2-1-1, twice the noise) with
+    C_m,α̇ −8.2 had C_m,δe −0.79 named the same way (beside α̇, t 0.1; probe seeds 4264, 4316)."""
     inner = interior(p)
     for c in cands:
         if not (c.selected and c.channel in cand.LON and c.channel in step.selections
