@@ -1307,6 +1307,41 @@ def test_a_corrected_airspeed_stands_in_the_altitude_again(monkeypatch):
     assert along.corrected_recording(p, kin, {"bias_p": -0.01}).altitude is p.altitude
 
 
+def test_a_gyro_skew_carries_the_accelerometer_to_the_cg_again(tmp_path):
+    """The probe's seed 4544: a c172x (6,000 ft / 167 ft/s, lateral 3-2-1-1s at 50 Hz, 1.5 times
+    the noise, the accelerometer declared 2.5 ft below the c.g.) with p 68 ms late had the skew
+    named (65 ms) and a C_Y,δa change of +0.070 beside it: a_y was carried to the c.g. with the
+    late ṗ. The skew's correction carries it again (prepare.recarried_accelerations), so the
+    skew imitates the change and reaches C_Y (sensor_naming.withhold_imitated_by_named)."""
+    truth, result = _diagnosed_probe(4544, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "c172x" and truth["parameter"] == "skew_p"
+    _named_alone(result, truth, rel=0.25)
+    term = next(c for c in result["candidates"] if c["parameter"] == "CY_da")
+    assert "the skew_p named" in term["reason"], term["reason"]
+
+
+def test_accelerations_carried_again_with_corrected_rates():
+    """prepare.recarried_accelerations: a_cg = a_s − [ω̇ × r + ω × (ω × r)]/g₀, so a rate
+    changed by δ moves the c.g. readings by the difference of that term (steady rates here,
+    ω̇ = 0: the centripetal part alone, analytic); nothing with the accelerometer at the c.g.
+    or no rate changed."""
+    from types import SimpleNamespace
+    from harness.diagnosis.prepare import recarried_accelerations
+    from models.constants import G0_FPS2
+    n = 40
+    raw = {"p": np.full(n, 0.1), "q": np.zeros(n), "r": np.zeros(n), "ax": np.zeros(n), "ay": np.zeros(n),
+           "az": np.full(n, -1.0)}
+    p = SimpleNamespace(meta={"accelerometer_at_cg": [0.0, 2.0, 0.0]}, raw=raw, recording=None, dt=0.02, n=n)
+    faster = dict(raw, p=np.full(n, 0.3))
+    out = recarried_accelerations(p, faster)
+    # ω × (ω × r) for ω = (p, 0, 0), r = (0, y, 0) is (0, −p² y, 0): a_y at the c.g. rises by (p₁² − p₀²) y / g₀
+    np.testing.assert_allclose(out["ay"], (0.3 ** 2 - 0.1 ** 2) * 2.0 / G0_FPS2)
+    np.testing.assert_allclose(out["ax"], 0.0, atol=1e-15)
+    np.testing.assert_allclose(out["az"], -1.0)
+    assert recarried_accelerations(p, dict(raw)) == {}
+    assert recarried_accelerations(SimpleNamespace(**{**vars(p), "meta": {}}), faster) == {}
+
+
 def test_skews_a_linearised_alpha_skew_leaves_are_not_named(tmp_path):
     """The probe's seed 4410: a noise-free F-4N (25,000 ft / 655 ft/s, three-axis 2-1-1s at
     100 Hz, metric units) with α 69 ms late had the skew named (66 ms, t 125) and beside it a_x

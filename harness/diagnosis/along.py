@@ -14,7 +14,7 @@ from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
 from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles, kinematic_alpha_rate
 from harness.diagnosis.prepare import (COEFFICIENTS, DRIVEN_BY, Prepared, clean_channels, interior_slice,
-                                       measured_coefficients, stand_in_altitude)
+                                       measured_coefficients, recarried_accelerations, stand_in_altitude)
 from models.aircraft import Aircraft
 from models.constants import SURFACES
 from models.replay import AeroAlong, InitialCondition, aero_along, initial_condition
@@ -26,10 +26,15 @@ def corrected_recording(p: Prepared, kin: KinematicResult, values: dict[str, flo
     altitude stood in from q̄ and V (:func:`prepare.stand_in_altitude`) is taken again from
     the corrected ones: a probe's J-3 Cub (3,350 ft / 97 ft/s, lateral multisine, no h) with V
     8.0 ft/s low stood in −2,780 ft for it, and the model flown there, its propeller's power
-    with it, had four lateral derivatives named (probe seed 4453)."""
+    with it, had four lateral derivatives named (probe seed 4453). Where the accelerometer is
+    off the c.g., a corrected rate carries it there again (:func:`prepare.recarried_accelerations`):
+    a probe's c172x (lateral 3-2-1-1s, accelerometer 2.5 ft below the c.g.) with p 68 ms late
+    had the skew named and a C_Y,δa change of +0.070 beside it, the late ṗ·z left in a_y
+    (probe seed 4544)."""
     if not values:
         return p
     ch = corrected_channels(p.raw, p, kin.parameters, values)
+    ch.update(recarried_accelerations(p, ch))
     smooth = {c: p.filt(x) for c, x in ch.items()}
     deriv = {c: p.differentiate(x) for c, x in ch.items()}
     k = max(1, int(round(0.5 / p.dt)))

@@ -160,10 +160,38 @@ def angular_accelerations(rec: Recording) -> list[np.ndarray]:
     d = rec.data
     if all(f"{c}dot_rps2" in d.columns for c in "pqr"):
         return [d[f"{c}dot_rps2"].to_numpy(dtype=float) for c in "pqr"]
-    half = max(2, int(round(0.5 * ACCEL_DERIVATIVE_WINDOW_S / rec.dt)))
-    window = min(2 * half + 1, rec.n - (1 - rec.n % 2))  # odd, and no longer than the record
-    return [local_polynomial_derivative(d[f"{c}_rps"].to_numpy(dtype=float), rec.dt, window=window, order=3)
-            for c in "pqr"]
+    return [rate_derivative(d[f"{c}_rps"].to_numpy(dtype=float), rec.dt) for c in "pqr"]
+
+
+def rate_derivative(x: np.ndarray, dt: float) -> np.ndarray:
+    """A rate's cubic local-polynomial derivative over :data:`ACCEL_DERIVATIVE_WINDOW_S`, as
+    the accelerometers are carried to the c.g. with (:func:`angular_accelerations`)."""
+    half = max(2, int(round(0.5 * ACCEL_DERIVATIVE_WINDOW_S / dt)))
+    window = min(2 * half + 1, x.size - (1 - x.size % 2))  # odd, and no longer than the record
+    return local_polynomial_derivative(x, dt, window=window, order=3)
+
+
+def recarried_accelerations(p: Prepared, rates: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The accelerometer channels carried to the c.g. again (:func:`accelerometer_to_cg`) with
+    the rates ``rates`` (p, q, r; rad/s) in place of the recorded ones: what a gyro's
+    correction does to them where the accelerometer is off the c.g. (``meta`` keeps its
+    position in ``accelerometer_at_cg``); empty where it is at the c.g. or no rate changed.
+    The angular accelerations are the recording's own where it gives them, else the rates'
+    derivative (:func:`rate_derivative`) as at the load."""
+    pos = p.meta.get("accelerometer_at_cg")
+    if not pos or not any(pos) or all(rates[c] is p.raw[c] for c in "pqr"):
+        return {}
+    old, new = [p.raw[c] for c in "pqr"], [rates[c] for c in "pqr"]
+    data = p.recording.data if p.recording is not None else None
+    if data is not None and all(f"{c}dot_rps2" in data.columns for c in "pqr"):
+        old_dot = new_dot = [data[f"{c}dot_rps2"].to_numpy(dtype=float) for c in "pqr"]
+    else:
+        old_dot, new_dot = [rate_derivative(x, p.dt) for x in old], [rate_derivative(x, p.dt) for x in new]
+    zero = np.zeros(p.n)
+    # a_cg = a_s − E(ω, ω̇)/g₀: the new c.g. reading is the old one plus E_old less E_new
+    less_old = accelerometer_at_cg(zero, zero, zero, *old, *old_dot, pos)
+    less_new = accelerometer_at_cg(zero, zero, zero, *new, *new_dot, pos)
+    return {c: p.raw[c] - o + n for c, o, n in zip(("ax", "ay", "az"), less_old, less_new)}
 
 
 def accelerometer_to_cg(rec: Recording) -> Recording:

@@ -14,8 +14,8 @@ from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.exact_skew import scale_beside_exact_skew, term_beside_exact_skew
 from harness.diagnosis.kinematics import KinematicResult, is_plausible, is_practical
 from harness.diagnosis.prepare import Prepared
-from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, Contest, kinematic_estimate, kinematic_share, kinematic_t,
-                                            kinematic_t_beside, unit_members, untestable_rival,
+from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYROS, Contest, kinematic_estimate, kinematic_share,
+                                            kinematic_t, kinematic_t_beside, unit_members, untestable_rival,
                                             kinematics_refute, sensor_verdict)
 from harness.diagnosis.stepwise_axes import StepwiseFits
 from harness.diagnosis.term_rules import DEPENDENT_SENSOR, IMITATION_SHARE, regressor_channel, term_change
@@ -481,12 +481,18 @@ def withhold_imitated_by_named(cands: list[Candidate], imitated, applied: set[st
     (:func:`along.model_states`), and its lateral derivatives vary with α. (A probe's F-15
     with its vane 1° high, 15,000 ft, doublets on each axis at 40 Hz, had the bias named on
     C_X, C_Z and C_m and beside it a C_l,β change of +0.0105 (t 14) and a C_n,p̂ of −0.060
-    (t −20), the model's C_l,β and C_n,p̂ at the vane's α.)"""
+    (t −20), the model's C_l,β and C_n,p̂ at the vane's α.) A rate gyro's error reaches the
+    force axes too where the accelerometer is off the c.g.: the rates and their derivatives
+    carry its readings there (:func:`prepare.recarried_accelerations`). (A probe's c172x,
+    6,000 ft / 167 ft/s, lateral 3-2-1-1s, accelerometer 2.5 ft below the c.g., with p 68 ms
+    late had the skew named and beside it a C_Y,δa change of +0.070, the late ṗ·z in a_y;
+    probe seed 4544.)"""
     named = [c for c in cands if c.selected and c.effect in SENSOR_EFFECTS and c.parameter not in applied]
     for sensor in named:
         channel = sensor.channel
         for c in cands:
-            reached = channel == "alpha" or channel in (DEPENDENT_SENSOR.get(c.channel or ""), regressor_channel(c))
+            reached = (channel == "alpha" or channel in (DEPENDENT_SENSOR.get(c.channel or ""), regressor_channel(c))
+                       or (channel in GYROS and c.channel in cand.FORCE_AXES))
             if not (c.selected and reached and c.test.startswith("stepwise")):
                 continue
             change = abs(term_change(c))
