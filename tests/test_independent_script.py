@@ -45,6 +45,12 @@ def _named_alone(result: dict, truth: dict, rel: float = 0.25) -> None:
     assert found[0][1] == pytest.approx(truth["truth"], rel=rel)
 
 
+def _withheld_for(result: dict, parameter: str, words: str) -> None:
+    """Candidate ``parameter`` is not named, its reason saying ``words``."""
+    c = next(c for c in result["candidates"] if c["parameter"] == parameter)
+    assert not c.get("selected") and words in c["reason"], c["reason"]
+
+
 def _placement(result):
     return next((a["stood_in_by"] for a in result["assumptions"] if a["item"] == "aerodynamic reference point"), "")
 
@@ -1267,8 +1273,7 @@ def test_a_shift_whose_stiffness_change_is_withheld_is_named_from_the_mistrim(tm
     truth, result = _diagnosed_probe(seed, tmp_path, calibrate=False)
     assert truth["parameter"] == "dx_moment_reference"
     _named_alone(result, truth, rel=0.25)
-    stiffness = next(c for c in result["candidates"] if c["parameter"] == "Cm_alpha")
-    assert "the shift is the candidate in its place" in stiffness["reason"], stiffness["reason"]
+    _withheld_for(result, "Cm_alpha", "the shift is the candidate in its place")
 
 
 def test_an_airspeed_correction_takes_the_stand_in_altitude_with_it(tmp_path):
@@ -1316,8 +1321,7 @@ def test_a_gyro_skew_carries_the_accelerometer_to_the_cg_again(tmp_path):
     truth, result = _diagnosed_probe(4544, tmp_path, calibrate=False)
     assert truth["aircraft"] == "c172x" and truth["parameter"] == "skew_p"
     _named_alone(result, truth, rel=0.25)
-    term = next(c for c in result["candidates"] if c["parameter"] == "CY_da")
-    assert "the skew_p named" in term["reason"], term["reason"]
+    _withheld_for(result, "CY_da", "the skew_p named")
 
 
 def test_accelerations_carried_again_with_corrected_rates():
@@ -1351,8 +1355,7 @@ def test_skews_a_linearised_alpha_skew_leaves_are_not_named(tmp_path):
     truth, result = _diagnosed_probe(4410, tmp_path, calibrate=False)
     assert truth["aircraft"] == "F4N" and truth["noise_factor"] == 0.0
     _named_alone(result, truth, rel=0.1)
-    ax = next(c for c in result["candidates"] if c["parameter"] == "skew_ax")
-    assert "first-order column's leftover" in ax["reason"], ax["reason"]
+    _withheld_for(result, "skew_ax", "first-order column's leftover")
 
 
 def test_a_shift_read_off_a_mistrim_an_alpha_bias_would_make_is_not_named(tmp_path):
@@ -1365,8 +1368,7 @@ def test_a_shift_read_off_a_mistrim_an_alpha_bias_would_make_is_not_named(tmp_pa
     truth, result = _diagnosed_probe(4332, tmp_path, calibrate=False)
     assert truth["aircraft"] == "A4" and truth["parameter"] == "Cm_alpha"
     assert _found(result) == []
-    shift = next(c for c in result["candidates"] if c["parameter"] == "dx_moment_reference")
-    assert "nor C_Z's constant" in shift["reason"], shift["reason"]
+    _withheld_for(result, "dx_moment_reference", "nor C_Z's constant")
 
 
 @pytest.mark.parametrize("seed", [4264, 4316])
@@ -1380,8 +1382,7 @@ def test_a_control_change_an_unoffered_alphadot_term_would_make_is_not_named(tmp
     truth, result = _diagnosed_probe(seed, tmp_path, calibrate=False)
     assert truth["parameter"] == "Cm_alphadot" and truth["kind"] == "pitch"
     assert _found(result) == []
-    de = next(c for c in result["candidates"] if c["parameter"] == "Cm_de")
-    assert "not offered because α never moved above its noise" in de["reason"], de["reason"]
+    _withheld_for(result, "Cm_de", "not offered because α never moved above its noise")
     assert result["findings"][0]["explanation"].startswith("No effect is named: ")
 
 
