@@ -1299,7 +1299,7 @@ def test_a_corrected_airspeed_stands_in_the_altitude_again(monkeypatch):
     raw = {"V": np.full(n, 300.0), "qbar": np.full(n, 0.5 * 0.0020482 * 300.0 ** 2), "p": np.zeros(n)}
     noise = {c: np.zeros(n) for c in raw}
     assert stand_in_altitude(raw, noise) == pytest.approx(density_altitude_ft(np.full(n, 0.0020482)))
-    p = SimpleNamespace(raw=raw, own_noise=noise, altitude=stand_in_altitude(raw, noise), dt=0.02,
+    p = SimpleNamespace(raw=raw, own_noise=noise, altitude=stand_in_altitude(raw, noise), dt=0.02, meta={},
                         filt=lambda x: x, differentiate=lambda x: np.zeros_like(x))
     kin = SimpleNamespace(parameters={})
     monkeypatch.setattr(along, "replace", lambda q, **kw: SimpleNamespace(**{**vars(q), **kw}))
