@@ -1324,6 +1324,30 @@ def test_a_gyro_skew_carries_the_accelerometer_to_the_cg_again(tmp_path):
     _withheld_for(result, "CY_da", "the skew_p named")
 
 
+def test_an_accelerometer_offset_rivalled_by_c_z_alpha_on_the_inertial_alpha(tmp_path):
+    """The probe's seed 4448: an A-4 (17,600 ft / 598 ft/s, a 0.7° pitch 3-2-1-1 at 50 Hz, 1.14
+    times the noise) with C_Z,α 0.81 more negative was named an accelerometer 10.4 ft aft
+    (t −7.0): the α vane's wander is as large as the maneuver's α, so C_Z,α on the vane's α
+    hardly fits (t +1.9 beside the position) and the clean q̇ of x·q̇ took its place. On the
+    inertial α the position falls to t −2.4 (candidates.offset_rival): not named."""
+    truth, result = _diagnosed_probe(4448, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "A4" and truth["parameter"] == "CZ_alpha"
+    assert _found(result) == []
+    _withheld_for(result, "x_accelerometer", "cannot tell it from CZ_alpha on the inertial α")
+
+
+def test_a_term_the_unnamed_accelerometer_position_imitates_is_withheld(tmp_path):
+    """The probe's seed 4560: an F-16 (21,100 ft / 595 ft/s, lateral 2-1-1s at 40 Hz, 1.38 times
+    the noise, ṗ, q̇, ṙ recorded) with the accelerometer 6.9 ft to the right had a C_Y,p̂ change
+    of −1.02 named (t −5.5): the force mismatches read the position (y 6.1 ± 0.3 ft, t 19), which
+    x_accelerometer does not name, and beside it the change stands at t −1.9
+    (accelerometer_rules.withhold_beside_the_accelerometer)."""
+    truth, result = _diagnosed_probe(4560, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "f16" and truth["parameter"] == "offset_y"
+    assert _found(result) == []
+    _withheld_for(result, "CY_phat", "imitated by the accelerometer's position")
+
+
 def test_accelerations_carried_again_with_corrected_rates():
     """prepare.recarried_accelerations: a_cg = a_s − [ω̇ × r + ω × (ω × r)]/g₀, so a rate
     changed by δ moves the c.g. readings by the difference of that term (steady rates here,

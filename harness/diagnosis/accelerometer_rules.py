@@ -105,8 +105,16 @@ def withhold_beside_the_accelerometer(cands: list[Candidate], selections: dict, 
     An independent script's c172x (186 ft/s, pitch sweep, 25 Hz, 22° bank) with the
     accelerometer 4 ft ahead had the position named at 2.45 ± 0.34 ft and, ahead of it, a
     C_Z,α̇ change of +6.3 (t −11.4) that stood at t −2.0 beside it. ``mismatch`` is the
-    force mismatch as evaluated, before the position's columns were taken out."""
-    if not any(c.selected and c.parameter == "x_accelerometer" for c in cands):
+    force mismatch as evaluated, before the position's columns were taken out.
+
+    Asked too where the position was read (a component at the entry t) but not named, as a
+    lateral or vertical arm is not (x_accelerometer names the x component, 1.5 ft or more): a
+    probe's F-16 (21,100 ft / 595 ft/s, lateral 2-1-1s at 40 Hz, 1.38 times the noise) with the
+    accelerometer 6.9 ft to the right read y = 6.12 ± 0.32 ft (t 19) and had a C_Y,p̂ change of
+    −1.02 named (t −5.5), the (p² + r²)·y the position puts in a_y."""
+    position = next((c for c in cands if c.parameter == "x_accelerometer"), None)
+    read = _read_component(position)
+    if position is None or not (position.selected or read):
         return
     for c in cands:
         if not (c.selected and c.channel in cand.FORCE_AXES and c.test.startswith("stepwise")):
@@ -123,10 +131,25 @@ def withhold_beside_the_accelerometer(cands: list[Candidate], selections: dict, 
             continue
         c.selected = False
         c.details["sensor_rival"] = "x_accelerometer"
-        c.reason = (f"entered after the named accelerometer position was taken out of the force mismatch, but "
-                    f"fitted beside the position (x = {x:.2f} ft) on the three force mismatches together it stands "
-                    f"at t = {t:.1f}, under the entry t of {cand.T_IN:g}: it is the part of the position that fit "
-                    "left")
+        if position.selected:
+            c.reason = (f"entered after the named accelerometer position was taken out of the force mismatch, but "
+                        f"fitted beside the position (x = {x:.2f} ft) on the three force mismatches together it "
+                        f"stands at t = {t:.1f}, under the entry t of {cand.T_IN:g}: it is the part of the position "
+                        "that fit left")
+        else:
+            c.reason = (f"entered, but imitated by the accelerometer's position, which the force mismatches read "
+                        f"though x_accelerometer does not name it: fitted beside it ({read}) on the three force "
+                        f"mismatches together it stands at t = {t:.1f}, under the entry t of {cand.T_IN:g}")
+
+
+def _read_component(position: Candidate | None) -> str:
+    """The accelerometer position's components the force mismatches read at the entry t
+    (:data:`candidates.T_IN`), as text ('' for none)."""
+    if position is None or "t_xyz" not in position.details:
+        return ""
+    d = position.details
+    return ", ".join(f"{a} = {d['position_ft'][i]:.2f} ± {d['std_error_ft'][i]:.2f} ft, t = {d['t_xyz'][i]:.1f}"
+                     for i, a in enumerate("xyz") if abs(d["t_xyz"][i]) >= cand.T_IN)
 
 
 def withhold_the_positions_rival(cands: list[Candidate]) -> None:

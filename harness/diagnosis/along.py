@@ -12,7 +12,8 @@ import numpy as np
 from estimators.smoothing import sine_series_filter
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.kinematics import KinematicResult, corrected_channels, inertial_angles, kinematic_alpha_rate
+from harness.diagnosis.kinematics import (INERTIAL_CHANNELS, KinematicResult, corrected_channels, inertial_angles,
+                                          kinematic_alpha_rate)
 from harness.diagnosis.prepare import (COEFFICIENTS, DRIVEN_BY, Prepared, clean_channels, interior_slice,
                                        measured_coefficients, recarried_accelerations, stand_in_altitude)
 from models.aircraft import Aircraft
@@ -156,9 +157,6 @@ def model_alpha_rate(p: Prepared) -> np.ndarray:
         return kinematic_alpha_rate(p.raw)
     return p.deriv["alpha"]
 
-
-# What the inertial sideslip is integrated from (kinematics.inertial_angles).
-INERTIAL_CHANNELS = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ay", "az")
 
 
 def undriven_inertial(p: Prepared) -> list[str]:

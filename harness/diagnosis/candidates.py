@@ -16,7 +16,7 @@ from scipy import signal
 
 from estimators.colored_stepwise import ColoredSelection, colored_fit, colored_forward_selection
 from estimators.least_squares import SingularRegressorsError, partial_correlation
-from harness.diagnosis.kinematics import kinematic_alpha_rate
+from harness.diagnosis.kinematics import inertial_alpha_change, kinematic_alpha_rate
 from harness.diagnosis.prepare import Prepared, filtered_noise_std, interior_slice
 from models.constants import SURFACES
 
@@ -466,6 +466,7 @@ class OffsetRival:
     correlation: float    # partial, of its stacked column with the offset's component
     t_offset: float       # the offset component's t beside it
     t_rival: float        # its t beside the offset
+    built_on: str = "the measured states"  # what its columns are built on (INERTIAL_ALPHA: the inertial α)
 
 
 # Only derivatives whose stacked column is at least this correlated with the offset's
@@ -473,16 +474,29 @@ class OffsetRival:
 OFFSET_RIVAL_CORRELATION = 0.3
 
 
+# The regressor key of the inertial α's change (kinematics.inertial_alpha_change) among the
+# offset's rival columns, and the derivative it stands for.
+INERTIAL_ALPHA = "alpha_inertial"
+
+
 def offset_rival_columns(reg: dict[str, np.ndarray], inner: slice) -> list[tuple[tuple[str, str], ...]]:
     """The coefficient errors :func:`offset_rival` tries beside the accelerometer's position,
     as (force axis, regressor) columns: each force axis's own derivatives
     (:data:`OWN_REGRESSORS`) alone, and each longitudinal one on C_X and C_Z together, a
     change of lift (or drag) along it, which the body axes share by the angle of attack
-    (C_X = C_L sin α − C_D cos α, C_Z = −C_L cos α − C_D sin α)."""
+    (C_X = C_L sin α − C_D cos α, C_Z = −C_L cos α − C_D sin α); where ``reg`` has the
+    inertial α (:data:`INERTIAL_ALPHA`), C_Z,α and that pair on it too."""
     moved = [r for r in reg if np.ptp(reg[r][inner]) > 0]
     out = [((axis, r),) for axis in FORCE_AXES for r in OWN_REGRESSORS["lon" if axis in LON else "lat"]
            if r in moved]
-    return out + [(("CX", r), ("CZ", r)) for r in OWN_REGRESSORS["lon"] if r in moved]
+    lon = [r for r in OWN_REGRESSORS["lon"] if r in moved] + [r for r in (INERTIAL_ALPHA,) if r in moved]
+    return out + [(("CZ", r),) for r in (INERTIAL_ALPHA,) if r in moved] + [(("CX", r), ("CZ", r)) for r in lon]
+
+
+def rival_parameter(axis: str, regressor: str) -> str:
+    """The derivative a rival column (:func:`offset_rival_columns`) stands for: the inertial
+    α's is the axis's α derivative."""
+    return f"{axis}_{'alpha' if regressor == INERTIAL_ALPHA else regressor}"
 
 
 def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, float],
@@ -502,7 +516,13 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
     (7,300 ft / 482 ft/s, pitch 3-2-1-1 at 40 Hz) read as an accelerometer 10.9 ft aft
     (t −6.6): beside C_Z,α alone it stood at −5.2, beside C_X,α and C_Z,α together at −1.5
     (they at −11 and −17); on 36 probe recordings with the accelerometer 4 ft ahead it stayed
-    at t 3.7-22 beside that pair. None when there is no such error."""
+    at t 3.7-22 beside that pair. C_Z,α is also tried on the inertial α
+    (:func:`kinematics.inertial_alpha_change`): an A-4 with C_Z,α 0.81 more negative (17,600 ft
+    / 598 ft/s, a 0.7° pitch 3-2-1-1, its α vane's wander 0.17° against the maneuver's 0.29°)
+    read as an accelerometer 10.4 ft aft (t −7.0), the clean q̇ of x·q̇ fitting what the noisy
+    vane's α could not (t −6.0 beside C_Z,α on the vane, t −2.4 on the inertial α); the 17 probe
+    recordings with the accelerometer 5-10 ft off kept the same t, or more, on the inertial α.
+    None when there is no such error."""
     k = int(np.argmax(np.abs(off.t)))
     if not np.isfinite(off.std_error_ft[k]):
         return None
@@ -513,6 +533,9 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
     name = "xyz"[k]
     others = [X[a] for a in keep if a != name] + I
     reg = regressors(p)
+    inertial = inertial_alpha_change(p)
+    if inertial is not None:
+        reg = reg | {INERTIAL_ALPHA: inertial}
     best = None
     for pairs in offset_rival_columns(reg, inner):
         cols = [np.concatenate([reg[r][inner] / noise[c] if c == axis else np.zeros(m) for c in axes])
@@ -530,5 +553,6 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
         t_rival = max((float(v) for v in theta[-n:] / se[-n:]), key=abs)
         prefers_offset = abs(t_off) >= AMBIGUOUS_T and abs(t_rival) < AMBIGUOUS_T
         if abs(t_off) < T_IN and not prefers_offset and (best is None or abs(t_off) < abs(best.t_offset)):
-            best = OffsetRival(" and ".join(f"{axis}_{r}" for axis, r in pairs), corr, t_off, t_rival)
+            best = OffsetRival(" and ".join(rival_parameter(axis, r) for axis, r in pairs), corr, t_off, t_rival,
+                               "the inertial α" if any(r == INERTIAL_ALPHA for _, r in pairs) else "the measured states")
     return best

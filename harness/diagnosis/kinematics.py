@@ -166,6 +166,19 @@ def _integrated(rate: np.ndarray, measured: np.ndarray, dt: float, drifts: tuple
     return x + A @ c
 
 
+# What the inertial angles are integrated from (:func:`inertial_angles`).
+INERTIAL_CHANNELS = ("V", "alpha", "beta", "p", "q", "r", "phi", "theta", "ay", "az")
+
+
+def inertial_alpha_change(p: Prepared) -> np.ndarray | None:
+    """The inertial α (:func:`inertial_angles`, from each channel's own smoothing) less the
+    vane's α at the start, free of the vane's noise; None without the channels it is
+    integrated from."""
+    if not all(k in p.smooth for k in INERTIAL_CHANNELS):
+        return None
+    return inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"]
+
+
 def inertial_angles(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndarray]:
     """α and β reconstructed from the inertial instruments: the body w and v equations of the
     module docstring integrated from the accelerometers, gyros and attitude, and placed on

@@ -42,7 +42,7 @@ def offset_candidate(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[s
     rival = cand.offset_rival(p, mismatch, noise, off) if sel else None
     if rival is not None:  # the mismatch is left whole for the stepwise fits to judge
         sel = False
-        reason = (f"not named: the force mismatch cannot tell it from {rival.parameter} "
+        reason = (f"not named: the force mismatch cannot tell it from {rival.parameter} on {rival.built_on} "
                   f"(r = {rival.correlation:+.2f}): "
                   f"beside it the position stands at t = {rival.t_offset:.1f}, and {rival.parameter} at t = "
                   f"{rival.t_rival:.1f} beside the position; the mismatch is left to the stepwise fits")

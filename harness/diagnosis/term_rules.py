@@ -12,13 +12,13 @@ from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.along import (INERTIAL_CHANNELS, corrected_recording, inertial_beta, interior, model_along,
-                                     rate_derivatives_advanced, undriven_inertial)
+from harness.diagnosis.along import (corrected_recording, inertial_beta, interior, model_along, rate_derivatives_advanced,
+                                     undriven_inertial)
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import turbulence_test
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
-from harness.diagnosis.kinematics import KinematicResult, inertial_angles, is_plausible
-from harness.diagnosis.prepare import Prepared, clean_channels
+from harness.diagnosis.kinematics import KinematicResult, inertial_alpha_change, is_plausible
+from harness.diagnosis.prepare import Prepared
 from harness.diagnosis.sensor_rules import (AMBIGUOUS_T, GYRO_UNIT, GYROS, kinematic_estimate, kinematic_std_error,
                                             kinematic_t, suspected_estimate, unit_members)
 from harness.diagnosis.stepwise_axes import (CG_MEAN_Z, StepwiseFits, constant_beside_terms, shift_mistrim_test,
@@ -396,10 +396,11 @@ def _beside_the_inertial_alpha(chosen: list[Candidate], step: StepwiseFits, p: P
     interior inertial α (:func:`kinematics.inertial_angles`, from each channel's own
     smoothing) less the vane's α at the start. Empty without the channels it is integrated
     from."""
-    if not chosen or not all(k in p.smooth for k in INERTIAL_CHANNELS):
+    full = inertial_alpha_change(p) if chosen else None
+    if full is None:
         return []
     inner = interior(p)
-    da = (inertial_angles(clean_channels(p, INERTIAL_CHANNELS), p)["alpha"] - p.start["alpha"])[inner]
+    da = full[inner]
     out = []
     for c in chosen:
         sel, by_key = step.selections[c.channel]
