@@ -12,7 +12,7 @@ from harness.diagnosis import candidates as cand
 from harness.diagnosis.along import corrected_recording, inertial_beta, interior, model_along, undriven_inertial
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
-from harness.diagnosis.kinematics import KinematicResult
+from harness.diagnosis.kinematics import PRACTICAL, KinematicResult
 from harness.diagnosis.prepare import Prepared, interior_slice
 from harness.diagnosis.sensor_rules import kinematic_estimate, plausible_kinematic_check
 from harness.diagnosis.term_rules import left_impractical, term_change
@@ -144,12 +144,15 @@ def withhold_beside_the_accelerometer(cands: list[Candidate], selections: dict, 
 
 def _read_component(position: Candidate | None) -> str:
     """The accelerometer position's components the force mismatches read at the entry t
-    (:data:`candidates.T_IN`), as text ('' for none)."""
+    (:data:`candidates.T_IN`) and of a practical size (``PRACTICAL["offset_ft"]``, as
+    x_accelerometer's), as text ('' for none). (A noise-free 787-8's x of −0.06 ± 0.01 ft
+    stood at t −7.7, and a C_Z α² change of −28 fell below the entry t beside it.)"""
     if position is None or "t_xyz" not in position.details:
         return ""
     d = position.details
     return ", ".join(f"{a} = {d['position_ft'][i]:.2f} ± {d['std_error_ft'][i]:.2f} ft, t = {d['t_xyz'][i]:.1f}"
-                     for i, a in enumerate("xyz") if abs(d["t_xyz"][i]) >= cand.T_IN)
+                     for i, a in enumerate("xyz")
+                     if abs(d["t_xyz"][i]) >= cand.T_IN and abs(d["position_ft"][i]) >= PRACTICAL["offset_ft"])
 
 
 def withhold_the_positions_rival(cands: list[Candidate]) -> None:
