@@ -673,16 +673,18 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
 
 def withhold_beside_the_unoffered_alphadot(cands: list[Candidate], step: StepwiseFits, mismatch: dict[str, np.ndarray],
                                            p: Prepared) -> None:
-    """Deselect a longitudinal term the α̇ term, not offered on its axis (α never moved above
-    its noise, :func:`candidates.offered`), would replace: its column correlated with α̇'s by
-    at least :data:`rivals.TERM_RIVAL_CORRELATION` and the term under the entry t
-    (:data:`candidates.T_IN`) beside it. The α̇ column is the kinematic one, from the gyros and
-    accelerometers, so it follows a short pulse's response even where the vane's α stays
-    within its noise; it could not be named there, but neither can what it imitates. A
-    probe's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with
-    C_m,α̇ −11.7 had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the α̇ column
-    (r −0.92) its t fell to 0.9, α̇'s stood at −13.6. A J-3 Cub (2-1-1, twice the noise) with
-    C_m,α̇ −8.2 had C_m,δe −0.79 named the same way (beside α̇, t 0.1; probe seeds 4264, 4316)."""
+    """Deselect a longitudinal term the α̇ term, not offered on its axis (the channel its α̇ is
+    built on never moved above its noise, :func:`candidates.offered`,
+    :func:`candidates.alpha_rate_sources`), would replace: its column
+    (:func:`candidates.alphadot_column`) correlated with α̇'s by at least
+    :data:`rivals.TERM_RIVAL_CORRELATION` and the term under the entry t
+    (:data:`candidates.T_IN`) beside it; it could not be named there, but neither can what it
+    imitates. A probe's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with
+    C_m,α̇ −11.7 had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the kinematic α̇
+    column (r −0.92) its t fell to 0.9, α̇'s stood at −13.6. A J-3 Cub (2-1-1, twice the noise)
+    with C_m,α̇ −8.2 had C_m,δe −0.79 named the same way (beside α̇, t 0.1; probe seeds 4264,
+    4316). C_m's α̇ is now offered wherever q is driven, and both are named; the rule stays for
+    C_X's and C_Z's, built on the vane's α."""
     inner = interior(p)
     for c in cands:
         if not (c.selected and c.channel in cand.LON and c.channel in step.selections
