@@ -1401,7 +1401,7 @@ def test_an_alphadot_term_is_offered_on_the_kinematic_alpha_rate(tmp_path, seed)
     c172p with C_m,α̇ −11.7 and −14.4. α never moved above its vane's noise, so no α̇ term was
     offered: C_m,δe −0.55 was named for what the kinematic α̇ column carries (seed 4264; a J-3
     Cub's, seed 4316, the same way), and later withheld beside it
-    (term_rules.withhold_beside_the_unoffered_alphadot), the c172p's nothing at all. C_m's α̇
+    (term_rules.withhold_beside_an_unoffered_term), the c172p's nothing at all. C_m's α̇
     column is the kinematic one, which follows the pitching motion where the vane's α stays
     in its noise, so it is offered where q is driven (candidates.alpha_rate_sources): named."""
     truth, result = _diagnosed_probe(seed, tmp_path, calibrate=False)

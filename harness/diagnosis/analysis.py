@@ -48,7 +48,7 @@ from harness.diagnosis.term_rules import (VANE_COLUMN_SENSORS, euler_lag_estimat
                                           withhold_force_drift_off_the_vane_wander,
                                           withhold_lateral_drift_off_the_vane,
                                           withhold_resting_on_an_uncertain_correction, withhold_rivals,
-                                          withhold_beside_the_unoffered_alphadot, withhold_shift_a_vane_bias_makes,
+                                          withhold_beside_an_unoffered_term, withhold_shift_a_vane_bias_makes,
                                           withhold_the_shift_remainder)
 from harness.diagnosis.wander_rules import withhold_within_the_unseen_wander
 from models.aircraft import Aircraft, has_propeller
@@ -162,7 +162,7 @@ def analyse(p: Prepared, aircraft: Aircraft, ic: InitialCondition) -> Analysis:
     withhold_within_the_unseen_wander(cands, step, p, mismatch)
     withhold_rivals(cands, step.selections, step.nuisances, mismatch, p, slope_of, kin, set(sensor_values), V0,
                     measured)
-    withhold_beside_the_unoffered_alphadot(cands, step, mismatch, p)
+    withhold_beside_an_unoffered_term(cands, step, mismatch, p)
     note_untested_coupling(cands, p)
     note_surface_scale(cands)
     column_sensors = {axis: VANE_COLUMN_SENSORS for axis, n in step.nuisances.items() if "vane_alpha_noise" in n}

@@ -119,6 +119,13 @@ class StepwiseFits:
     shares: dict            # (axis, key) -> share of the coefficient's excursion
     pinned: CgMeanTest | None = None  # a moment-reference shift sized by C_m's mistrim
     ar_t: dict = field(default_factory=dict)  # (axis, key) -> t with the AR autocorrelation (candidates.AR_ENTRY_T)
+    unoffered: dict = field(default_factory=dict)  # axis -> [Term] not offered for an undriven source (UNOFFERED_RIVALS)
+
+
+# The terms kept, where they were not offered because their source was not driven
+# (candidates.offered), as rivals of what is named in their place
+# (term_rules.withhold_beside_an_unoffered_term).
+UNOFFERED_RIVALS = ("alphadot", "dV")
 
 
 # The α vane's noise column enters C_m's fit where it is a material part of the mismatch:
@@ -187,9 +194,10 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
     columns), with the thrust nuisance where thrust was not recorded and the α vane's noise
     column (:func:`vane_noise_columns`) where the model follows the vane; drift terms that
     thrust or a propeller would imitate are not offered."""
-    selections, nuisances, not_offered, shares, pools, ar_t = {}, {}, {}, {}, {}, {}
+    selections, nuisances, not_offered, shares, pools, ar_t, unoffered = {}, {}, {}, {}, {}, {}, {}
     for axis in COEFFICIENTS:
         terms, skipped = cand.offered(p, cand.library(p, axis, aero.derivatives, measured, aero.coefficients))
+        unoffered[axis] = [t for t in skipped if t.key in UNOFFERED_RIVALS]
         not_offered[axis] = [{"effect": t.effect, "parameter": t.parameter, "sources": list(t.sources)}
                              | ({"reason": t.details["not_offered"]} if "not_offered" in t.details else {})
                              for t in skipped]
@@ -224,7 +232,7 @@ def stepwise_fits(p: Prepared, propeller: bool, aero: AeroAlong, measured: dict[
             pools[a] = (terms, extra)
         not_offered[axis].append({"effect": "cg_offset", "parameter": "dx_moment_reference", "sources": ["alpha"],
                                   "reason": test.reason})
-    return StepwiseFits(selections, nuisances, not_offered, shares, pinned, ar_t)
+    return StepwiseFits(selections, nuisances, not_offered, shares, pinned, ar_t, unoffered)
 
 
 def pinned_shift(test: CgMeanTest, p: Prepared | None = None, trim: TrimPoint | None = None) -> Candidate:

@@ -671,49 +671,60 @@ def withhold_rivals(cands: list[Candidate], selections: dict, nuisances: dict, m
                                             slope_of, p, inner)
 
 
-def withhold_beside_the_unoffered_alphadot(cands: list[Candidate], step: StepwiseFits, mismatch: dict[str, np.ndarray],
-                                           p: Prepared) -> None:
-    """Deselect a longitudinal term the α̇ term, not offered on its axis (the channel its α̇ is
-    built on never moved above its noise, :func:`candidates.offered`,
-    :func:`candidates.alpha_rate_sources`), would replace: its column
-    (:func:`candidates.alphadot_column`) correlated with α̇'s by at least
-    :data:`rivals.TERM_RIVAL_CORRELATION` and the term under the entry t
-    (:data:`candidates.T_IN`) beside it; it could not be named there, but neither can what it
-    imitates. A probe's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with
-    C_m,α̇ −11.7 had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the kinematic α̇
-    column (r −0.92) its t fell to 0.9, α̇'s stood at −13.6. A J-3 Cub (2-1-1, twice the noise)
-    with C_m,α̇ −8.2 had C_m,δe −0.79 named the same way (beside α̇, t 0.1; probe seeds 4264,
-    4316). C_m's α̇ is now offered wherever q is driven, and both are named; the rule stays for
-    C_X's and C_Z's, built on the vane's α."""
+def withhold_beside_an_unoffered_term(cands: list[Candidate], step: StepwiseFits, mismatch: dict[str, np.ndarray],
+                                      p: Prepared) -> None:
+    """Deselect a term that a term not offered on its axis (its source never moved above its
+    noise, :func:`candidates.offered`; the kinds :data:`stepwise_axes.UNOFFERED_RIVALS`) would
+    replace: beside the unoffered term's column the term falls under the entry t
+    (:data:`candidates.T_IN`), the two columns correlated by at least
+    :data:`rivals.TERM_RIVAL_CORRELATION` or the unoffered term standing at the entry t beside
+    it. The unoffered term could not be named there, but neither can what it imitates.
+
+    A probe's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with C_m,α̇ −11.7
+    had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the kinematic α̇ column (r −0.92)
+    its t fell to 0.9, α̇'s stood at −13.6; a J-3 Cub's C_m,α̇ −8.2 the same way (probe seeds
+    4264, 4316; C_m's α̇ is now offered wherever q is driven, and both are named, so for α̇ the
+    rule serves C_X's and C_Z's). A T-37 (16,900 ft / 363 ft/s, a 0.18-1.5 Hz pitch sweep,
+    0.31 times the noise) with C_m ΔV/V +1.19 had a C_m,q̂ change of +2.9 named (t 9.0): the
+    airspeed moved 0.2 %, 2.3 times its noise, so no ΔV/V term was offered, yet beside its
+    column (r 0.56) C_m,q̂ fell to t 1.7 and ΔV/V stood at 11.1 — in a sweep's pitching motion
+    the airspeed follows q (ΔV ≈ (g/ω²)·q at each frequency; probe seed 4639)."""
     inner = interior(p)
     for c in cands:
-        if not (c.selected and c.channel in cand.LON and c.channel in step.selections
-                and any(d["parameter"] == f"{c.channel}_alphadot" for d in step.not_offered.get(c.channel, ()))):
+        rivals_here = [t for t in step.unoffered.get(c.channel, ()) if t.parameter != c.parameter]
+        if not (c.selected and rivals_here and c.channel in step.selections):
             continue
         sel, by_key = step.selections[c.channel]
         key = next((k for k, t in by_key.items() if t.parameter == c.parameter and k in sel.names), None)
-        if key is None:
+        if key is None or np.ptp(by_key[key].column[inner]) <= 0:
             continue
-        column, adot = by_key[key].column[inner], cand.alphadot_column(p, c.channel)[inner]
-        if np.ptp(column) <= 0 or np.ptp(adot) <= 0:
-            continue
-        r = float(np.corrcoef(column, adot)[0, 1])
-        if abs(r) < rivals.TERM_RIVAL_CORRELATION:
-            continue
+        column = by_key[key].column[inner]
         nuisance = [col[inner] for col in step.nuisances.get(c.channel, {}).values() if np.ptp(col[inner]) > 0]
         others = [by_key[n].column[inner] for n in sel.names if n != key and n in by_key] + nuisance
-        try:
-            t_term, t_adot = rivals.t_pair(mismatch[c.channel][inner], others, column, adot)
-        except (SingularRegressorsError, np.linalg.LinAlgError):
-            t_term, t_adot = 0.0, 0.0
-        if abs(t_term) >= cand.T_IN:
-            continue
-        c.selected = False
-        c.details["unoffered_rival"] = {"parameter": f"{c.channel}_alphadot", "effect": "unsteady_alphadot",
-                                        "correlation": r, "t_term": t_term, "t_rival": t_adot}
-        c.reason = (f"entered, but not named: an α̇ term, not offered because α never moved above its noise, "
-                    f"would explain it as well (columns correlated {r:+.2f}; beside it, t = {t_term:.1f}, the α̇ "
-                    f"term's t = {t_adot:.1f})")
+        for rival in rivals_here:
+            rc = rival.column[inner]
+            if np.ptp(rc) <= 0:
+                continue
+            r = float(np.corrcoef(column, rc)[0, 1])
+            try:
+                t_term, t_rival = rivals.t_pair(mismatch[c.channel][inner], others, column, rc)
+            except (SingularRegressorsError, np.linalg.LinAlgError):
+                continue
+            if abs(t_term) >= cand.T_IN or (abs(r) < rivals.TERM_RIVAL_CORRELATION and abs(t_rival) < cand.T_IN):
+                continue
+            c.selected = False
+            c.details["unoffered_rival"] = {"parameter": rival.parameter, "effect": rival.effect, "correlation": r,
+                                            "t_term": t_term, "t_rival": t_rival}
+            c.reason = (f"entered, but not named: a {rival.parameter} term, not offered because "
+                        f"{_unoffered_why(rival)}, would explain it as well (columns correlated {r:+.2f}; beside "
+                        f"it, t = {t_term:.1f}, the {rival.parameter} term's t = {t_rival:.1f})")
+            break
+
+
+def _unoffered_why(term) -> str:
+    """Why an unoffered rival (:func:`withhold_beside_an_unoffered_term`) was not offered."""
+    what = {"alpha": "α", "V": "the airspeed", "q": "q", "beta": "β"}
+    return " and ".join(f"{what.get(s, s)} never moved above its noise" for s in term.sources)
 
 
 def withhold_for_an_unchecked_scale(c: Candidate, sources: tuple[str, ...], kin: KinematicResult, z: np.ndarray,
