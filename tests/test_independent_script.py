@@ -1348,6 +1348,19 @@ def test_a_term_the_unnamed_accelerometer_position_imitates_is_withheld(tmp_path
     _withheld_for(result, "CY_phat", "imitated by the accelerometer's position")
 
 
+def test_a_rate_change_an_unoffered_airspeed_drift_would_make_is_not_named(tmp_path):
+    """The probe's seed 4639: a T-37 (16,900 ft / 363 ft/s, a 0.18-1.5 Hz pitch sweep at 40 Hz,
+    0.31 times the noise) with C_m ΔV/V +1.19 had a C_m,q̂ change of +2.9 named (t 9.0). The
+    airspeed moved 0.2 %, 2.3 times its noise, so no ΔV/V term was offered; beside its column
+    C_m,q̂ falls to t 1.7 and ΔV/V stands at 11.1 (term_rules.withhold_beside_an_unoffered_term):
+    nothing is named, and the verdict says a term was withheld."""
+    truth, result = _diagnosed_probe(4639, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "T37" and truth["parameter"] == "Cm_dV"
+    assert _found(result) == []
+    _withheld_for(result, "Cm_qhat", "a Cm_dV term, not offered because the airspeed never moved above its noise")
+    assert result["findings"][0]["explanation"].startswith("No effect is named: ")
+
+
 def test_accelerations_carried_again_with_corrected_rates():
     """prepare.recarried_accelerations: a_cg = a_s − [ω̇ × r + ω × (ω × r)]/g₀, so a rate
     changed by δ moves the c.g. readings by the difference of that term (steady rates here,
