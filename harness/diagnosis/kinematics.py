@@ -150,6 +150,15 @@ def sensor_parameters(p: Prepared) -> tuple[SensorParameter, ...]:
     return tuple(out)
 
 
+# The rates one of which every rotational term of an accelerometer arm along each body axis
+# carries (ω̇ × r + ω × (ω × r)): an arm along y reads ṙ·y in a_x, −(p² + r²)·y in a_y and
+# ṗ·y + q·r·y in a_z. Where the maneuver drove neither (p.driven), the arm is not offered: a
+# probe's noise-free c172p on a pitch multisine (a 44 ms q skew named) had a 5.6 ft lateral
+# arm named at t 9 off the propeller's slight yaw (ṙ·y in a_x, 22 % of a_x's small
+# excursion; seed 4697).
+ARM_RATES = {"offset_x": ("q", "r"), "offset_y": ("p", "r"), "offset_z": ("p", "q")}
+
+
 def _integral(x: np.ndarray, dt: float) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (x[1:] + x[:-1]) * dt)])
 
@@ -314,6 +323,11 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
             dropped[f"skew_{c}"] = (f"{c} hardly moves and the maneuver did not drive it ({moves:.3g} {UNITS[c]}, "
                                     f"under {MIN_EXCITATION:g} times the smallest {c} bias worth naming): a skew of it "
                                     "would be no practical error")
+    for name, rates in ARM_RATES.items():
+        if name in columns and p.driven and not any(r in p.driven for r in rates):
+            columns.pop(name)
+            dropped[name] = (f"the maneuver drove neither {' nor '.join(rates)}: every rotational term of an arm along "
+                             f"{name[-1]} carries one of them, so its column is their noise and slight coupled motion")
     for c in SCALE_CHANNELS:
         s, b = columns.get(f"scale_{c}"), columns.get(f"bias_{c}")
         if s is not None and b is not None and np.ptp(s) > 0 and np.ptp(b) > 0:
