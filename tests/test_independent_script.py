@@ -1361,6 +1361,17 @@ def test_a_rate_change_an_unoffered_airspeed_drift_would_make_is_not_named(tmp_p
     assert result["findings"][0]["explanation"].startswith("No effect is named: ")
 
 
+def test_no_lateral_accelerometer_arm_on_a_pitch_maneuver(tmp_path):
+    """The probe's seed 4697: a noise-free c172p (6,600 ft / 173 ft/s, a pitch multisine at
+    50 Hz) with q 44 ms late had the skew named and beside it an accelerometer 5.6 ft right of
+    the c.g. (t 9), read off the propeller's slight yaw, ṙ·y in a_x. The maneuver drove neither
+    p nor r, which every term of a lateral arm carries: not offered (kinematics.ARM_RATES)."""
+    truth, result = _diagnosed_probe(4697, tmp_path, calibrate=False)
+    assert truth["aircraft"] == "c172p" and truth["parameter"] == "skew_q"
+    _named_alone(result, truth, rel=0.25)
+    assert not any(c["parameter"] == "offset_y" for c in result["candidates"])
+
+
 def test_accelerations_carried_again_with_corrected_rates():
     """prepare.recarried_accelerations: a_cg = a_s − [ω̇ × r + ω × (ω × r)]/g₀, so a rate
     changed by δ moves the c.g. readings by the difference of that term (steady rates here,
