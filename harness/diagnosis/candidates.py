@@ -566,6 +566,6 @@ def offset_rival(p: Prepared, mismatch: dict[str, np.ndarray], noise: dict[str, 
         t_rival = max((float(v) for v in theta[-n:] / se[-n:]), key=abs)
         prefers_offset = abs(t_off) >= AMBIGUOUS_T and abs(t_rival) < AMBIGUOUS_T
         if abs(t_off) < T_IN and not prefers_offset and (best is None or abs(t_off) < abs(best.t_offset)):
-            best = OffsetRival(" and ".join(rival_parameter(axis, r) for axis, r in pairs), corr, t_off, t_rival,
-                               "the inertial α" if any(r == INERTIAL_ALPHA for _, r in pairs) else "the measured states")
+            on = "the inertial α" if any(r == INERTIAL_ALPHA for _, r in pairs) else "the measured states"
+            best = OffsetRival(" and ".join(rival_parameter(axis, r) for axis, r in pairs), corr, t_off, t_rival, on)
     return best

@@ -119,7 +119,7 @@ class StepwiseFits:
     shares: dict            # (axis, key) -> share of the coefficient's excursion
     pinned: CgMeanTest | None = None  # a moment-reference shift sized by C_m's mistrim
     ar_t: dict = field(default_factory=dict)  # (axis, key) -> t with the AR autocorrelation (candidates.AR_ENTRY_T)
-    unoffered: dict = field(default_factory=dict)  # axis -> [Term] not offered for an undriven source (UNOFFERED_RIVALS)
+    unoffered: dict = field(default_factory=dict)  # axis -> [Term] not offered, source undriven (UNOFFERED_RIVALS)
 
 
 # The terms kept, where they were not offered because their source was not driven

@@ -12,8 +12,8 @@ from estimators.colored_stepwise import colored_fit
 from estimators.least_squares import SingularRegressorsError
 from harness.diagnosis import rivals
 from harness.diagnosis import candidates as cand
-from harness.diagnosis.along import (corrected_recording, inertial_beta, interior, model_along, rate_derivatives_advanced,
-                                     undriven_inertial)
+from harness.diagnosis.along import (corrected_recording, inertial_beta, interior, model_along,
+                                     rate_derivatives_advanced, undriven_inertial)
 from harness.diagnosis.evidence import Candidate
 from harness.diagnosis.gust_rules import turbulence_test
 from harness.diagnosis.kinematics import T_IN as KIN_T_IN
