@@ -178,3 +178,31 @@ def test_an_accelerometer_position_from_the_force_mismatch_does_not_correct_the_
                                                                                           terms=()))
     withhold_delays_imitated_by_named([position, delay], kin, None, None, None, {}, {}, set())
     assert delay.selected and position.selected
+
+
+def test_the_offset_rival_columns_on_the_inertial_alpha():
+    """candidates.offset_rival_columns: with the inertial α among the regressors, C_Z,α on it
+    alone and C_X,α with C_Z,α on it are tried too, both standing for the α derivative
+    (rival_parameter); without it, only the measured states' columns."""
+    from harness.diagnosis.candidates import INERTIAL_ALPHA, offset_rival_columns, rival_parameter
+    n = 20
+    moving = np.linspace(0.0, 1.0, n)
+    reg = {"alpha": moving, "qhat": moving ** 2, "de": np.zeros(n)}
+    plain = offset_rival_columns(reg, slice(0, n))
+    assert not any(r == INERTIAL_ALPHA for pairs in plain for _, r in pairs)
+    assert (("CX", "alpha"), ("CZ", "alpha")) in plain and (("CZ", "de"),) not in plain
+    more = offset_rival_columns(reg | {INERTIAL_ALPHA: moving}, slice(0, n))
+    assert set(more) - set(plain) == {(("CZ", INERTIAL_ALPHA),), (("CX", INERTIAL_ALPHA), ("CZ", INERTIAL_ALPHA))}
+    assert rival_parameter("CZ", INERTIAL_ALPHA) == "CZ_alpha" and rival_parameter("CZ", "qhat") == "CZ_qhat"
+
+
+def test_an_unnamed_position_counts_where_a_component_is_significant_and_practical():
+    """accelerometer_rules._read_component: the components the force mismatches read at the
+    entry t and of at least 1.5 ft; a significant 0.06 ft one (a noise-free record's) is not."""
+    from harness.diagnosis.accelerometer_rules import _read_component
+    details = {"position_ft": [-0.06, 6.12, 0.5], "std_error_ft": [0.008, 0.32, 0.4], "t_xyz": [-7.7, 19.4, 1.2]}
+    off = Candidate("sensor_offset", "lon", "accelerometer", "x_accelerometer", -0.06, 0.008, -7.7, 0.1, "ft",
+                    "force mismatch", False, "not significant, under 1.5 ft", details)
+    assert _read_component(off) == "y = 6.12 ± 0.32 ft, t = 19.4"
+    details["position_ft"][1] = 1.2
+    assert _read_component(off) == "" and _read_component(None) == ""
