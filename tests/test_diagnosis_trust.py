@@ -1365,8 +1365,7 @@ def _alpha_power_case(linear: float, cubic: float, monkeypatch):
     alpha = 0.09 + da
     z = linear * da + cubic * da ** 3 + 5e-5 * rng.standard_normal(n)
     inertial = alpha + 0.00017 * rng.standard_normal(n)
-    monkeypatch.setattr(term_rules, "clean_channels", lambda p, names: {})
-    monkeypatch.setattr(term_rules, "inertial_angles", lambda ch, p: {"alpha": inertial})
+    monkeypatch.setattr(term_rules, "inertial_alpha_change", lambda p: inertial - p.start["alpha"])
     term = SimpleNamespace(parameter="Cm_alpha3", column=da ** 3, scale=1.0)
     step = SimpleNamespace(selections={"Cm": (SimpleNamespace(names=("alpha3",), params={}), {"alpha3": term})},
                            nuisances={"Cm": {}})

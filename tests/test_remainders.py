@@ -96,8 +96,7 @@ def _slope_case(change: float, monkeypatch):
     z = 4.5 * e + change * da + 1e-4 * rng.standard_normal(n)
     vane = da + e
     inertial = 0.06 + da + 0.0001 * rng.standard_normal(n)
-    monkeypatch.setattr(term_rules, "clean_channels", lambda p, names: {})
-    monkeypatch.setattr(term_rules, "inertial_angles", lambda ch, p: {"alpha": inertial})
+    monkeypatch.setattr(term_rules, "inertial_alpha_change", lambda p: inertial - p.start["alpha"])
     monkeypatch.setattr(term_rules, "interior", lambda p: slice(0, p.n))
     fit = np.polyfit(vane, z, 1)[0]
     term = SimpleNamespace(parameter="CZ_alpha", column=vane, scale=1.0)

@@ -137,12 +137,14 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
     """The measured coefficients and the model's along the states of :func:`model_states`
     (its inertial sideslip integrated from ``inertial_from``, default ``p``; the vane's
     sideslip with ``vane_beta``; both vanes' own records with ``vanes``), its α̇ terms on
-    :func:`model_alpha_rate` wherever α follows the maneuver (driven, moved, or inertial,
-    :func:`undriven_inertial`). (Without α̇ where the model followed the inertial α, the
-    model's own C_m,α̇ stayed in the mismatch: c182 and c172p's with C_m,α̇ 11.7 and 14.4 more
-    negative, α within its vane's noise, read 17.8 and 21.5 more negative.)"""
+    :func:`model_alpha_rate` where α is driven or moved. (Where α follows the maneuver only
+    inertially, :func:`undriven_inertial`, the model's own α̇ terms stay in the mismatch, and
+    an equation-error C_m,α̇ change there carries them: c182 and c172p's C_m,α̇ changes of
+    −11.7 and −14.4 read −17.8 and −21.5, −11.9 and −15.4 calibrated in the loop. Evaluated on
+    the raw channels' kinematic α̇ there, they passed a probe F-4N's 10.5 Hz mode ringing in q
+    and a_z into C_m's model, and C_m,δe was named beside the mode.)"""
     states, surfaces = model_states(p, inertial_from, vane_beta, vanes)
-    alphadot = model_alpha_rate(p) if "alpha" in (*p.driven, *p.moved, *undriven_inertial(p)) else None
+    alphadot = model_alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
     aero = filtered(aero_along(aircraft, ic, states, surfaces, alphadot), p.weights)
     measured = measured_coefficients(p.smooth, p.deriv, p.meta, p.mass, thrust_stand_in(p, aero.trim.thrust_lbf))
     return ModelAlong(states, surfaces, alphadot, aero, measured, p.weights)
