@@ -87,8 +87,10 @@ def alpha_rate_sources(p: Prepared, axis: str) -> tuple[str, ...]:
     the kinematic one, which follows the pitching motion even where the vane's α stays within
     its noise. Four probe recordings (a c182, a J-3 Cub, two c172p's at 1-1.8 times the noise,
     pitch doublets and 2-1-1s) with C_m,α̇ 8-14 more negative and α within its vane's noise had
-    C_m,δe named in its place or nothing; offered on q, C_m,α̇ is named within 7 % on each,
-    and the other ten kept probe recordings whose α was not driven kept their verdicts."""
+    C_m,δe named in its place or nothing; offered on q, C_m,α̇ is named on each, within 7 %
+    calibrated in the loop (the equation-error size carries the model's own C_m,α̇ there,
+    :func:`along.model_along`), and the other ten kept probe recordings whose α was not driven
+    kept their verdicts."""
     if axis in VANE_ALPHA_RATE_AXES or not all(c in p.smooth for c in ALPHA_RATE_CHANNELS):
         return ("alpha",)
     return ("q",)
