@@ -139,10 +139,9 @@ def model_along(p: Prepared, aircraft: Aircraft, ic: InitialCondition,
     sideslip with ``vane_beta``; both vanes' own records with ``vanes``), its α̇ terms on
     :func:`model_alpha_rate` where α is driven or moved. (Where α follows the maneuver only
     inertially, :func:`undriven_inertial`, the model's own α̇ terms stay in the mismatch, and
-    an equation-error C_m,α̇ change there carries them: c182 and c172p's C_m,α̇ changes of
-    −11.7 and −14.4 read −17.8 and −21.5, −11.9 and −15.4 calibrated in the loop. Evaluated on
-    the raw channels' kinematic α̇ there, they passed a probe F-4N's 10.5 Hz mode ringing in q
-    and a_z into C_m's model, and C_m,δe was named beside the mode.)"""
+    no α̇ term is offered there, :func:`candidates.offered`. Evaluated there on the raw
+    channels' kinematic α̇ they passed a probe F-4N's 10.5 Hz mode ringing in q and a_z into
+    C_m's model, and C_m,δe was named beside the mode.)"""
     states, surfaces = model_states(p, inertial_from, vane_beta, vanes)
     alphadot = model_alpha_rate(p) if "alpha" in p.driven or "alpha" in p.moved else None
     aero = filtered(aero_along(aircraft, ic, states, surfaces, alphadot), p.weights)

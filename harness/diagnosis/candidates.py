@@ -81,21 +81,6 @@ def alpha_rate(p: Prepared, axis: str = "Cm") -> np.ndarray:
     return kinematic_alpha_rate(p.smooth)
 
 
-def alpha_rate_sources(p: Prepared, axis: str) -> tuple[str, ...]:
-    """The recorded channel the maneuver must drive for an α̇ term of ``axis`` to be offered
-    (:func:`offered`): the vane's α where :func:`alpha_rate` differentiates it; q where α̇ is
-    the kinematic one, which follows the pitching motion even where the vane's α stays within
-    its noise. Four probe recordings (a c182, a J-3 Cub, two c172p's at 1-1.8 times the noise,
-    pitch doublets and 2-1-1s) with C_m,α̇ 8-14 more negative and α within its vane's noise had
-    C_m,δe named in its place or nothing; offered on q, C_m,α̇ is named on each, within 7 %
-    calibrated in the loop (the equation-error size carries the model's own C_m,α̇ there,
-    :func:`along.model_along`), and the other ten kept probe recordings whose α was not driven
-    kept their verdicts."""
-    if axis in VANE_ALPHA_RATE_AXES or not all(c in p.smooth for c in ALPHA_RATE_CHANNELS):
-        return ("alpha",)
-    return ("q",)
-
-
 def alphadot_column(p: Prepared, axis: str) -> np.ndarray:
     """The regressor of an unsteady α̇ term of ``axis``: α̇ c̄/2V (effects.md's
     unsteady_alphadot), α̇ from :func:`alpha_rate`."""
@@ -170,7 +155,7 @@ def library(p: Prepared, axis: str, derivatives: dict[str, float], measured: dic
                               sources=(REGRESSOR_SOURCE[r],)))
     if axis in LON:
         terms.append(Term("alphadot", "unsteady_alphadot", f"{axis}_alphadot", "per rad (alphadot c/2V)",
-                          alphadot_column(p, axis), sources=alpha_rate_sources(p, axis)))
+                          alphadot_column(p, axis), sources=("alpha",)))
         terms.append(Term("alpha2", "nonlinear_alpha", f"{axis}_alpha2", "per rad^2", a ** 2, sources=("alpha",)))
         terms.append(Term("alpha3", "nonlinear_alpha", f"{axis}_alpha3", "per rad^3", a ** 3, sources=("alpha",)))
     else:
