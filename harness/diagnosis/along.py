@@ -163,7 +163,6 @@ def model_alpha_rate(p: Prepared) -> np.ndarray:
     return p.deriv["alpha"]
 
 
-
 def undriven_inertial(p: Prepared) -> list[str]:
     """The vane angles the maneuver's own input moved but not clear of the vane's noise
     (their group's surface moved, :data:`prepare.DRIVEN_BY`, and they are neither driven nor
