@@ -206,3 +206,14 @@ def test_an_unnamed_position_counts_where_a_component_is_significant_and_practic
     assert _read_component(off) == "y = 6.12 ± 0.32 ft, t = 19.4"
     details["position_ft"][1] = 1.2
     assert _read_component(off) == "" and _read_component(None) == ""
+
+
+def test_an_unoffered_rival_says_which_of_its_sources_was_not_driven():
+    """term_rules._unoffered_why names only the sources the maneuver did not drive: a lateral
+    axis's ΔV/V term (sources V and β) on a lateral maneuver lacks the airspeed alone."""
+    from harness.diagnosis.term_rules import _unoffered_why
+    lateral_dv = SimpleNamespace(sources=("V", "beta"))
+    assert _unoffered_why(lateral_dv, SimpleNamespace(driven=("beta", "p", "r"))) == \
+        "the airspeed never moved above its noise"
+    assert _unoffered_why(lateral_dv, SimpleNamespace(driven=("q",))) == \
+        "the airspeed never moved above its noise and β never moved above its noise"

@@ -1386,7 +1386,8 @@ def test_accelerations_carried_again_with_corrected_rates():
     p = SimpleNamespace(meta={"accelerometer_at_cg": [0.0, 2.0, 0.0]}, raw=raw, recording=None, dt=0.02, n=n)
     faster = dict(raw, p=np.full(n, 0.3))
     out = recarried_accelerations(p, faster)
-    # ω × (ω × r) for ω = (p, 0, 0), r = (0, y, 0) is (0, −p² y, 0): a_y at the c.g. rises by (p₁² − p₀²) y / g₀
+    # ω × (ω × r) for ω = (p, 0, 0), r = (0, y, 0) is (0, −p² y, 0):
+    # a_y at the c.g. rises by (p₁² − p₀²) y / g₀
     np.testing.assert_allclose(out["ay"], (0.3 ** 2 - 0.1 ** 2) * 2.0 / G0_FPS2)
     np.testing.assert_allclose(out["ax"], 0.0, atol=1e-15)
     np.testing.assert_allclose(out["az"], -1.0)

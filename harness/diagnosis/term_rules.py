@@ -683,10 +683,11 @@ def withhold_beside_an_unoffered_term(cands: list[Candidate], step: StepwiseFits
     A probe's c182 (7,000 ft / 165 ft/s, pitch doublets, 1.8 times the noise) with C_m,α̇ −11.7
     had C_m,δe −0.55 named (t 22.6, the model −0.82): beside the kinematic α̇ column (r −0.92)
     its t fell to 0.9, α̇'s stood at −13.6; a J-3 Cub's C_m,α̇ −8.2 the same way (probe seeds
-    4264, 4316; C_m's α̇ is now offered wherever q is driven, and both are named, so for α̇ the
-    rule serves C_X's and C_Z's). A T-37 (16,900 ft / 363 ft/s, a 0.18-1.5 Hz pitch sweep,
-    0.31 times the noise) with C_m ΔV/V +1.19 had a C_m,q̂ change of +2.9 named (t 9.0): the
-    airspeed moved 0.2 %, 2.3 times its noise, so no ΔV/V term was offered, yet beside its
+    4264, 4316; offering C_m's α̇ there on q named both, but also, on a c172x null, the model's
+    own C_m,α̇, which the model along the inertial α leaves out: tried and dropped). A T-37
+    (16,900 ft / 363 ft/s, a 0.18-1.5 Hz pitch sweep, 0.31 times the noise) with C_m ΔV/V
+    +1.19 had a C_m,q̂ change of +2.9 named (t 9.0): the airspeed moved 0.2 %, 2.3 times its
+    noise, so no ΔV/V term was offered, yet beside its
     column (r 0.56) C_m,q̂ fell to t 1.7 and ΔV/V stood at 11.1 — in a sweep's pitching motion
     the airspeed follows q (ΔV ≈ (g/ω²)·q at each frequency; probe seed 4639)."""
     inner = interior(p)
@@ -709,22 +710,24 @@ def withhold_beside_an_unoffered_term(cands: list[Candidate], step: StepwiseFits
             try:
                 t_term, t_rival = rivals.t_pair(mismatch[c.channel][inner], others, column, rc)
             except (SingularRegressorsError, np.linalg.LinAlgError):
-                continue
+                t_term, t_rival = 0.0, 0.0  # the columns cannot be told apart: withheld if correlated
             if abs(t_term) >= cand.T_IN or (abs(r) < rivals.TERM_RIVAL_CORRELATION and abs(t_rival) < cand.T_IN):
                 continue
             c.selected = False
             c.details["unoffered_rival"] = {"parameter": rival.parameter, "effect": rival.effect, "correlation": r,
                                             "t_term": t_term, "t_rival": t_rival}
             c.reason = (f"entered, but not named: a {rival.parameter} term, not offered because "
-                        f"{_unoffered_why(rival)}, would explain it as well (columns correlated {r:+.2f}; beside "
+                        f"{_unoffered_why(rival, p)}, would explain it as well (columns correlated {r:+.2f}; beside "
                         f"it, t = {t_term:.1f}, the {rival.parameter} term's t = {t_rival:.1f})")
             break
 
 
-def _unoffered_why(term) -> str:
-    """Why an unoffered rival (:func:`withhold_beside_an_unoffered_term`) was not offered."""
-    what = {"alpha": "α", "V": "the airspeed", "q": "q", "beta": "β"}
-    return " and ".join(f"{what.get(s, s)} never moved above its noise" for s in term.sources)
+def _unoffered_why(term, p: Prepared) -> str:
+    """Why an unoffered rival (:func:`withhold_beside_an_unoffered_term`) was not offered: its
+    sources the maneuver did not drive (:attr:`Prepared.driven`)."""
+    what = {"alpha": "α", "V": "the airspeed", "beta": "β"}
+    undriven = [s for s in term.sources if s not in p.driven] or list(term.sources)
+    return " and ".join(f"{what.get(s, s)} never moved above its noise" for s in undriven)
 
 
 def withhold_for_an_unchecked_scale(c: Candidate, sources: tuple[str, ...], kin: KinematicResult, z: np.ndarray,
