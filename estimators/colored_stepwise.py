@@ -72,6 +72,47 @@ def colored_fit(z: np.ndarray, columns: Sequence[np.ndarray], names: Sequence[st
     return ls.theta, np.sqrt(np.maximum(np.diag(cov), 0.0)), ls.residuals
 
 
+def _sse_of(z: np.ndarray, cols: Sequence[np.ndarray]) -> float:
+    """The residual sum of squares of ``z`` fitted by ``cols`` in least squares (rank-deficient
+    columns by the minimum-norm solution)."""
+    if not cols:
+        return float(z @ z)
+    A = np.column_stack(cols)
+    theta, *_ = np.linalg.lstsq(A, z, rcond=None)
+    r = z - A @ theta
+    return float(r @ r)
+
+
+def _sse_with_each(z: np.ndarray, cols: Sequence[np.ndarray], candidates: Mapping[str, np.ndarray],
+                   rtol: float = 1e-10) -> dict[str, float]:
+    """:func:`_sse_of` ``(z, cols + [c])`` for each candidate ``c``, by projection: with ``Q`` an
+    orthonormal basis of ``cols``, ``r`` the residual of ``z`` on it and ``c⊥`` the candidate's,
+    the sum is ``r·r − (r·c⊥)² / (c⊥·c⊥)`` (the same least squares, one factorisation for all).
+    A base or candidate dependent to ``rtol`` of its size is fitted directly instead."""
+    if not candidates:
+        return {}
+    if not cols:
+        Q, r = np.zeros((z.size, 0)), z
+    else:
+        Q, R = np.linalg.qr(np.column_stack(cols))
+        d = np.abs(np.diag(R))
+        if d.min() <= rtol * d.max():
+            return {n: _sse_of(z, list(cols) + [c]) for n, c in candidates.items()}
+        r = z - Q @ (Q.T @ z)
+    rr = float(r @ r)
+    C = np.column_stack(list(candidates.values()))
+    C_perp = C - Q @ (Q.T @ C)
+    size, left = np.einsum("ij,ij->j", C, C), np.einsum("ij,ij->j", C_perp, C_perp)
+    along = r @ C_perp
+    out = {}
+    for j, (n, c) in enumerate(candidates.items()):
+        if left[j] <= (rtol ** 2) * size[j]:
+            out[n] = _sse_of(z, list(cols) + [c])
+        else:
+            out[n] = max(rr - along[j] ** 2 / left[j], 0.0)
+    return out
+
+
 def colored_forward_selection(z: npt.ArrayLike, candidates: Mapping[str, npt.ArrayLike], *,
                               forced: Mapping[str, npt.ArrayLike] | None = None, t_in: float = 5.0,
                               min_gain: float = 0.05, max_terms: int = 3,
@@ -94,19 +135,13 @@ def colored_forward_selection(z: npt.ArrayLike, candidates: Mapping[str, npt.Arr
     chosen: list[str] = []
     gains: dict[str, float] = {}
 
-    def sse_of(names: list[str]) -> float:
-        cols = list(forced.values()) + [pool[n] for n in names] + ([np.ones(z.size)] if constant else [])
-        if not cols:
-            return float(z @ z)
-        A = np.column_stack(cols)
-        theta, *_ = np.linalg.lstsq(A, z, rcond=None)
-        r = z - A @ theta
-        return float(r @ r)
+    def base(names: list[str]) -> list[np.ndarray]:
+        return list(forced.values()) + [pool[n] for n in names] + ([np.ones(z.size)] if constant else [])
 
-    sse_start = sse_of([])
+    sse_start = _sse_of(z, base([]))
     sse_now = sse_start
     while len(chosen) < max_terms:
-        trial = {n: sse_of(chosen + [n]) for n in pool if n not in chosen}
+        trial = _sse_with_each(z, base(chosen), {n: c for n, c in pool.items() if n not in chosen})
         if not trial:
             break
         best = min(trial, key=trial.get)

@@ -1,6 +1,7 @@
 """Which aircraft to fly, in which variant, and loading it into JSBSim."""
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -204,8 +205,14 @@ def is_turboprop(model: str) -> bool:
 
 def has_propeller(model: str) -> bool:
     """Whether any of the model's thrusters is a JSBSim ``<propeller>`` (its torque, P-factor
-    and slipstream then change with airspeed at a fixed throttle, outside the aerodynamics)."""
+    and slipstream then change with airspeed at a fixed throttle, outside the aerodynamics;
+    read once per version of the aircraft file, as :func:`aerodynamics_reads`)."""
     source = model_xml(model)
+    return _has_propeller(source, source.stat().st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=64)
+def _has_propeller(source: Path, _mtime_ns: int) -> bool:
     prop = ET.parse(source).getroot().find("propulsion")
     places = (engine_root(source) / "engine", source.parent, source.parent / "Engines")
     for el in (prop.iter("thruster") if prop is not None else []):
@@ -239,13 +246,20 @@ def missing_files(model: str) -> list[str]:
     return missing
 
 
-def aerodynamics_reads(model: str) -> set[str]:
+def aerodynamics_reads(model: str) -> frozenset[str]:
     """The properties an aircraft XML's ``<aerodynamics>`` reads (``<property>`` and
-    ``<independentVar>`` elements)."""
-    aero = ET.parse(model_xml(model)).getroot().find("aerodynamics")
+    ``<independentVar>`` elements), read once per version of the file (a diagnosis asks about
+    a hundred times: the parses were a twelfth of its time)."""
+    source = model_xml(model)
+    return _aerodynamics_reads(source, source.stat().st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=64)
+def _aerodynamics_reads(source: Path, _mtime_ns: int) -> frozenset[str]:
+    aero = ET.parse(source).getroot().find("aerodynamics")
     if aero is None:
-        return set()
-    return {(el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar")}
+        return frozenset()
+    return frozenset((el.text or "").strip() for el in aero.iter() if el.tag in ("property", "independentVar"))
 
 
 def xml_surface_properties(model: str) -> dict[str, str]:

@@ -186,6 +186,27 @@ def test_colored_selection_finds_the_true_term_and_nothing_in_noise():
     assert hits == 0
 
 
+def test_each_candidate_s_sum_of_squares_by_projection_is_the_least_squares_one():
+    """colored_stepwise._sse_with_each: r·r − (r·c⊥)²/(c⊥·c⊥) on the base's orthonormal basis is
+    each candidate's least-squares sum of squares beside the base; a candidate in the base's
+    span adds nothing, and a dependent base is fitted directly."""
+    from estimators.colored_stepwise import _sse_of, _sse_with_each
+    rng = np.random.default_rng(3)
+    n = 400
+    base = [rng.normal(size=n), np.ones(n)]
+    cands = {"a": rng.normal(size=n), "b": rng.normal(size=n), "in_span": 2.0 * base[0] - 3.0}
+    z = 0.7 * base[0] + 0.4 * cands["b"] + rng.normal(size=n)
+    got = _sse_with_each(z, base, cands)
+    for name, c in cands.items():
+        A = np.column_stack(base + [c])
+        r = z - A @ np.linalg.lstsq(A, z, rcond=None)[0]
+        assert got[name] == pytest.approx(float(r @ r), rel=1e-10)
+    assert got["in_span"] == pytest.approx(_sse_of(z, base), rel=1e-10)
+    dependent = base + [2.0 * base[1]]
+    assert _sse_with_each(z, dependent, {"a": cands["a"]})["a"] == pytest.approx(_sse_of(z, base + [cands["a"]]))
+    assert _sse_with_each(z, [], {"a": cands["a"]})["a"] == pytest.approx(_sse_of(z, [cands["a"]]))
+
+
 def test_theil_u_and_whiteness():
     y = np.array([1.0, -1.0, 1.0, -1.0])
     assert theil_u(y, y) == 0.0

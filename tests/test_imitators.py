@@ -125,6 +125,23 @@ def test_an_airspeed_bias_reads_as_a_gust_that_follows_the_flight_path(three_axi
     assert "an airspeed bias of +8.7 ft/s" in gusts_of_an_airspeed_bias(p, gust, float(np.mean(p.smooth["V"])))
 
 
+def test_a_kinematic_column_is_the_filtered_change_of_its_parts(three_axis_f16):
+    """kinematics._residual_change: the common filter and its derivative are linear, so an
+    equation's residual at one set of channels less that at another is the filtered and
+    differentiated change of its parts, to rounding (a part unchanged adds nothing)."""
+    from harness.diagnosis.kinematics import _kinematic_parts, _residual_change, kinematic_residuals
+    from harness.diagnosis.prepare import prepare
+    p = prepare(three_axis_f16)
+    other = dict(p.raw, q=p.raw["q"] + 0.01, az=p.raw["az"] * 1.02)
+    before, after = kinematic_residuals(p.raw, p), kinematic_residuals(other, p)
+    parts, parts_other = _kinematic_parts(p.raw, p), _kinematic_parts(other, p)
+    for e in before:
+        scale = float(np.max(np.abs(after[e]))) + 1.0
+        np.testing.assert_allclose(_residual_change(parts_other[e], parts[e], p), after[e] - before[e],
+                                   atol=1e-11 * scale)
+    assert not _residual_change(parts["h"], parts["h"], p).any()
+
+
 def _validation(term_size: float, seed: int):
     """A validation maneuver's C_X mismatch: white noise (σ = 1e-3) plus ``term_size`` times a
     term column, and that term predicted at size 1 (its identification's)."""

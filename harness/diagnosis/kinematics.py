@@ -237,6 +237,13 @@ def kinematic_alpha_rate(ch: dict[str, np.ndarray]) -> np.ndarray:
 
 def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.ndarray]:
     """E per kinematic equation (module docstring) from raw-rate channels ``ch``."""
+    return {e: p.differentiate(d) - p.filt(f) for e, (d, f) in _kinematic_parts(ch, p).items()}
+
+
+def _kinematic_parts(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per kinematic equation, the record differentiated and the one filtered: its residual
+    (:func:`kinematic_residuals`) is the first's common-filter derivative less the second's
+    common filtering."""
     V, a, b = ch["V"], ch["alpha"], ch["beta"]
     u, v, w = V * np.cos(a) * np.cos(b), V * np.sin(b), V * np.sin(a) * np.cos(b)
     P, Q, R, phi, th = ch["p"], ch["q"], ch["r"], ch["phi"], ch["theta"]
@@ -246,21 +253,30 @@ def kinematic_residuals(ch: dict[str, np.ndarray], p: Prepared) -> dict[str, np.
     # 0.04 g a_z bias as 0.04376 (now 0.04139): gravity there is 0.24 % less
     at = h if h is not None else getattr(p, "altitude", None)
     g = G0 * (EARTH_RADIUS_FT / (EARTH_RADIUS_FT + (at if at is not None else 0.0))) ** 2
-    D, F = p.differentiate, p.filt
     out = {
-        "u": D(u) - F(R * v - Q * w - g * np.sin(th) + G0 * ch["ax"]),
-        "v": D(v) - F(P * w - R * u + g * np.cos(th) * np.sin(phi) + G0 * ch["ay"]),
-        "w": D(w) - F(Q * u - P * v + g * np.cos(th) * np.cos(phi) + G0 * ch["az"]),
-        "phi": D(phi) - F(P + np.tan(th) * (Q * np.sin(phi) + R * np.cos(phi))),
-        "theta": D(th) - F(Q * np.cos(phi) - R * np.sin(phi)),
+        "u": (u, R * v - Q * w - g * np.sin(th) + G0 * ch["ax"]),
+        "v": (v, P * w - R * u + g * np.cos(th) * np.sin(phi) + G0 * ch["ay"]),
+        "w": (w, Q * u - P * v + g * np.cos(th) * np.cos(phi) + G0 * ch["az"]),
+        "phi": (phi, P + np.tan(th) * (Q * np.sin(phi) + R * np.cos(phi))),
+        "theta": (th, Q * np.cos(phi) - R * np.sin(phi)),
     }
     if h is not None:
-        out["h"] = D(h) - F(u * np.sin(th) - v * np.sin(phi) * np.cos(th) - w * np.cos(phi) * np.cos(th))
+        out["h"] = (h, u * np.sin(th) - v * np.sin(phi) * np.cos(th) - w * np.cos(phi) * np.cos(th))
     if "psi" in ch:
         # the heading sees the yaw gyro directly: without it an r bias (−R·u in the v
         # equation) is one column with an a_y bias
-        out["psi"] = D(np.unwrap(ch["psi"])) - F((Q * np.sin(phi) + R * np.cos(phi)) / np.cos(th))
+        out["psi"] = (np.unwrap(ch["psi"]), (Q * np.sin(phi) + R * np.cos(phi)) / np.cos(th))
     return out
+
+
+def _residual_change(plus: tuple[np.ndarray, np.ndarray], minus: tuple[np.ndarray, np.ndarray],
+                     p: Prepared) -> np.ndarray:
+    """One equation's residual at ``plus`` less that at ``minus`` (:func:`_kinematic_parts`),
+    as the filtered and differentiated change of its parts: the common filter and its
+    derivative are linear, so this is half the transforms, and none for a part unchanged."""
+    d, f = plus[0] - minus[0], plus[1] - minus[1]
+    out = p.differentiate(d) if d.any() else np.zeros(d.size)
+    return out - p.filt(f) if f.any() else out
 
 
 @dataclass(frozen=True)
@@ -305,10 +321,11 @@ def kinematic_check(p: Prepared, *, t_in: float = T_IN, min_gain: float = 0.02, 
     columns = {}
     at = clean | inertial_angles(clean, p)
     for name, sp in params.items():
-        plus = kinematic_residuals(sp.correct(at, p, sp.step), p)
-        minus = kinematic_residuals(sp.correct(at, p, -sp.step), p)
+        plus = _kinematic_parts(sp.correct(at, p, sp.step), p)
+        minus = _kinematic_parts(sp.correct(at, p, -sp.step), p)
         # E(0) ≈ −J θ: regress E(0) on −J
-        columns[name] = np.concatenate([-(plus[e][inner] - minus[e][inner]) / (2 * sp.step) * weights[e] for e in eqs])
+        columns[name] = np.concatenate([-_residual_change(plus[e], minus[e], p)[inner] / (2 * sp.step) * weights[e]
+                                        for e in eqs])
     dropped, untestable = {}, {}
     for c in set(SCALE_CHANNELS) | set(SKEW_CHANNELS):
         moves = float(np.std(clean[c][inner])) if c in clean else 0.0

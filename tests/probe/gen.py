@@ -181,48 +181,59 @@ def fly(root, model, h, V, sim_hz, cmd, stick=False, delay=None, turb=None, aero
     wn, zeta = act
     nsub = 8
     hs = dt / nsub
-    state = {s: [0.0, 0.0] for s in drive}
     hist = {s: np.zeros(n) for s in drive}  # actuator output (pre-delay)
     mass = fdm["inertia/mass-slugs"]
     keys = ["V", "alpha", "beta", "p", "q", "r", "phi", "theta", "psi", "fx", "fy", "fz", "pdot", "qdot", "rdot",
             "de", "da", "dr", "qbar", "h", "mach", "thrust", "alphadot"]
     out = {k: np.zeros(n) for k in keys}
 
+    node = fdm.get_property_manager().get_node  # property nodes: no path parsed per access
+    reads = [("V", "velocities/vt-fps"), ("alpha", "aero/alpha-rad"), ("beta", "aero/beta-rad")]
+    for a in "pqr":
+        reads += [(a, f"velocities/{a}i-rad_sec"), (a + "dot", f"accelerations/{a}idot-rad_sec2")]
+    reads += [("phi", "attitude/phi-rad"), ("theta", "attitude/theta-rad"), ("psi", "attitude/psi-rad")]
+    getters = [(out[k], node(p).get_double_value) for k, p in reads]
+    forces = [(out["f" + a], node(f"forces/fb{a}-total-lbs").get_double_value) for a in "xyz"]
+    getters += [(out[k], node(p).get_double_value) for k, p in
+                [("qbar", "aero/qbar-psf"), ("h", "position/h-sl-ft"), ("mach", "velocities/mach"),
+                 ("thrust", "forces/fbx-prop-lbs"), ("alphadot", "aero/alphadot-rad_sec")]]
+    surf_getters = [(out[s], node(surf[s]).get_double_value) for s in ("de", "da", "dr")] if stick else []
+    setters = {s: node(p).set_double_value for s, p in drive.items()}
+    right_aileron = node("fcs/right-aileron-pos-rad").set_double_value if (
+        not stick and drive.get("da") == "fcs/left-aileron-pos-rad") else None
+    mg = mass * G0
+
     def sample(i):
-        out["V"][i] = fdm["velocities/vt-fps"]
-        out["alpha"][i] = fdm["aero/alpha-rad"]
-        out["beta"][i] = fdm["aero/beta-rad"]
-        for a in "pqr":
-            out[a][i] = fdm[f"velocities/{a}i-rad_sec"]
-            out[a + "dot"][i] = fdm[f"accelerations/{a}idot-rad_sec2"]
-        out["phi"][i] = fdm["attitude/phi-rad"]
-        out["theta"][i] = fdm["attitude/theta-rad"]
-        out["psi"][i] = fdm["attitude/psi-rad"]
-        for a in "xyz":
-            out["f" + a][i] = fdm[f"forces/fb{a}-total-lbs"] / (mass * G0)
-        out["qbar"][i] = fdm["aero/qbar-psf"]
-        out["h"][i] = fdm["position/h-sl-ft"]
-        out["mach"][i] = fdm["velocities/mach"]
-        out["thrust"][i] = fdm["forces/fbx-prop-lbs"]
-        out["alphadot"][i] = fdm["aero/alphadot-rad_sec"]
+        for arr, get in getters:
+            arr[i] = get()
+        for arr, get in forces:
+            arr[i] = get() / mg
         if stick:
-            for s in ("de", "da", "dr"):
-                out[s][i] = fdm[surf[s]]
+            for arr, get in surf_getters:
+                arr[i] = get()
         else:
             for s in ("de", "da", "dr"):
                 out[s][i] = trim_in[s] + hist[s][i]
 
+    # the actuators see only their commands: their outputs come first, step by step as flown
+    w2, c2 = wn * wn, 2 * zeta * wn
+    for s in drive:  # in Python floats (IEEE doubles, as NumPy's: the same numbers, faster)
+        x, v = 0.0, 0.0
+        c, h_s = cmd[s].tolist(), [0.0] * n
+        for i in range(1, n):
+            u = c[i - 1]
+            for _ in range(nsub):
+                v += hs * (w2 * (u - x) - c2 * v)
+                x += hs * v
+            h_s[i] = x
+        hist[s][:] = h_s
+    hist_list = {s: h.tolist() for s, h in hist.items()}
+    run = fdm.run
+    alpha, q, phi = out["alpha"], out["q"], out["phi"]
     sample(0)
     for i in range(1, n):
         for s in drive:
-            x, v = state[s]
-            u = cmd[s][i - 1]
-            for _ in range(nsub):
-                v += hs * (wn * wn * (u - x) - 2 * zeta * wn * v)
-                x += hs * v
-            state[s] = [x, v]
-            hist[s][i] = x
-            applied = x
+            applied = hist_list[s][i]
             if delay and s == delay[0]:
                 tq = i - delay[1] * sim_hz
                 if tq <= 0:
@@ -231,14 +242,14 @@ def fly(root, model, h, V, sim_hz, cmd, stick=False, delay=None, turb=None, aero
                     k = int(math.floor(tq))
                     f = tq - k
                     applied = hist[s][k] * (1 - f) + hist[s][min(k + 1, i)] * f
-            fdm[drive[s]] = trim_in[s] + applied
-            if not stick and s == "da" and drive[s] == "fcs/left-aileron-pos-rad":
-                fdm["fcs/right-aileron-pos-rad"] = -(trim_in[s] + applied)
-        fdm.run()
+            setters[s](trim_in[s] + applied)
+            if right_aileron is not None and s == "da":
+                right_aileron(-(trim_in[s] + applied))
+        run()
         sample(i)
-        a = out["alpha"][i]
-        if not np.isfinite(a) or abs(a) > 30 * DEG or not np.isfinite(out["q"][i]) or abs(out["phi"][i]) > 80 * DEG:
-            raise Skip(f"flight diverged at t={i * dt:.2f}s (alpha={a / DEG:.1f} deg, phi={out['phi'][i] / DEG:.0f} deg)")
+        a = alpha[i]
+        if not math.isfinite(a) or abs(a) > 30 * DEG or not math.isfinite(q[i]) or abs(phi[i]) > 80 * DEG:
+            raise Skip(f"flight diverged at t={i * dt:.2f}s (alpha={a / DEG:.1f} deg, phi={phi[i] / DEG:.0f} deg)")
     out["trim"] = {"alpha": out["alpha"][0], "V": out["V"][0], "h": out["h"][0], "theta": out["theta"][0]}
     out["fdm"] = fdm
     return out
