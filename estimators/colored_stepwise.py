@@ -67,8 +67,9 @@ def colored_fit(z: np.ndarray, columns: Sequence[np.ndarray], names: Sequence[st
     if not constant and not len(columns):
         return np.zeros(0), np.zeros(0), np.asarray(z, dtype=float).copy()
     A = np.column_stack(list(columns) + ([np.ones(z.size)] if constant else []))
-    ls = least_squares(A, z, tuple(names) + (("bias",) if constant else ()))
-    cov = colored_residual_covariance(A, ls.residuals, max_lag=max_lag, autocorrelation=autocorrelation)
+    ls = least_squares(A, z, tuple(names) + (("bias",) if constant else ()), keep_factor=True)
+    cov = colored_residual_covariance(A, ls.residuals, max_lag=max_lag, autocorrelation=autocorrelation,
+                                      factor=ls.factor)
     return ls.theta, np.sqrt(np.maximum(np.diag(cov), 0.0)), ls.residuals
 
 

@@ -68,12 +68,24 @@ class TrimPoint:
         return asdict(self)
 
 
+# Under this altitude (ft above sea level) the terrain is put this far below the aircraft
+# (JSBSim's terrain is at sea level): an altitude standing in from the density (a cold day's,
+# or an airspeed read low) can be under sea level, where the gear stood on the ground and no
+# trim existed (a probe's J-3 Cub at a stand-in -2,780 ft: JSBSim's trim and the project's
+# each failed, taking a second apiece, before the untrimmed fall-back).
+LOW_ALTITUDE_FT = 500.0
+TERRAIN_CLEARANCE_FT = 1000.0
+
+
 def set_initial_condition(fdm: jsbsim.FGFDMExec, h_ft: float, V_fps: float) -> None:
     """Set position, altitude, then speed: the order matters (the notes: setting latitude
-    after speed silently changes the speed)."""
+    after speed silently changes the speed). Under :data:`LOW_ALTITUDE_FT` the terrain is
+    lowered to :data:`TERRAIN_CLEARANCE_FT` below the aircraft: the project flies in the air."""
     fdm["ic/lat-gc-deg"] = 0.0
     fdm["ic/long-gc-deg"] = 0.0
     fdm["ic/psi-true-deg"] = 0.0
+    if h_ft < LOW_ALTITUDE_FT:
+        fdm["ic/terrain-elevation-ft"] = h_ft - TERRAIN_CLEARANCE_FT
     fdm["ic/h-sl-ft"] = h_ft
     fdm["ic/vt-fps"] = V_fps
     fdm["ic/gamma-deg"] = 0.0

@@ -241,3 +241,20 @@ def test_a_recording_that_starts_banked_trims_the_model_in_that_steady_turn():
     level = trim(load_fdm(aircraft, 1 / 120), aircraft,
                  InitialCondition(5000.0, 185.0, phi_rad=math.radians(TURN_BANK_MIN_DEG / 2)).condition())
     assert level.method == "jsbsim" and abs(level.phi_rad) < 0.01 and tp.thrust_lbf > 1.05 * level.thrust_lbf
+
+
+def test_an_altitude_under_sea_level_trims_in_the_air():
+    """models.trim.set_initial_condition: an altitude standing in from the density can be under
+    sea level, JSBSim's terrain; there the J-3 Cub's gear stood on the ground and neither
+    JSBSim's trim nor the project's found an equilibrium (a probe's stand-in -2,780 ft). The
+    terrain is lowered under the aircraft: it trims as JSBSim trims it at altitude, 1,000 ft up."""
+    from pathlib import Path
+
+    from models.trim import TERRAIN_CLEARANCE_FT
+    xml = str(Path(jsbsim.get_default_root_dir()) / "aircraft" / "J3Cub" / "J3Cub.xml")
+    aircraft = Aircraft(xml)
+    fdm = load_fdm(aircraft, 1 / 120)
+    tp = trim(fdm, aircraft, FlightCondition("cold day", -2780.0, 97.5))
+    assert tp.method == "jsbsim" and tp.h_ft == pytest.approx(-2780.0, abs=1.0)
+    assert fdm["position/h-agl-ft"] == pytest.approx(TERRAIN_CLEARANCE_FT, abs=1.0)
+    assert abs(fdm["accelerations/udot-ft_sec2"]) < 1e-3 and abs(fdm["accelerations/wdot-ft_sec2"]) < 1e-3
