@@ -1435,9 +1435,10 @@ def test_a_control_change_an_unoffered_alphadot_term_would_make_is_not_named(tmp
     assert result["findings"][0]["explanation"].startswith("No effect is named: ")
 
 
-@pytest.mark.parametrize("seed", [3769, 4169, 4197])
+@pytest.mark.parametrize("seed", [3769, 4197])
 def test_a_sensor_error_a_mode_under_the_search_floor_makes_is_not_named(tmp_path, seed):
-    """The probe's seeds 3769, 4169 and 4197: a noise-free T-37, an F-16 and an A-4 on lateral
+    """The probe's seeds 3769, 4169 and 4197 (4169, the F-16's, left out of the suite for its
+    time; it gives none as the others do): a noise-free T-37, an F-16 and an A-4 on lateral
     maneuvers with a mode driven by the aileron ringing q and a_z at 3.8, 4.0 and 4.7 Hz, under
     where the mode search starts (6 Hz, twice the motion's 3 Hz cut-off). An a_z skew of −68 ms and
     β biases of 0.67° and 0.28° were named. The band between the motion's cut-off and the floor
